@@ -1,0 +1,206 @@
+"""Pilot configuration: frozen dataclasses, loaded from and saved to YAML.
+
+Every error names the offending option by its dotted path (``controller.fire_ms``) and the file.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import types
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TypeVar
+
+import yaml
+
+from pilot.errors import ConfigError
+
+HsvTriple = tuple[int, int, int]
+HsvRange = tuple[HsvTriple, HsvTriple]
+
+# Red wraps around hue 0 in OpenCV's 0..179 hue scale: it needs two ranges.
+DEFAULT_RED: tuple[HsvRange, ...] = (
+    ((0, 120, 70), (8, 255, 255)),
+    ((172, 120, 70), (179, 255, 255)),
+)
+
+
+@dataclass(frozen=True)
+class HsvConfig:
+    ranges: tuple[HsvRange, ...] = DEFAULT_RED
+    min_area: int = 30
+    open_kernel: int = 3
+
+
+@dataclass(frozen=True)
+class ArucoConfig:
+    dictionary: str = "DICT_4X4_50"
+    marker_id: int = 7  # -1: any marker
+    marker_size_m: float = 0.3
+
+
+@dataclass(frozen=True)
+class ControllerConfig:
+    acquire_frames: int = 3  # consecutive sightings before tracking
+    lost_frames: int = 6  # consecutive misses before the target counts as lost
+    dead_band_x: float = 0.10  # normalised horizontal image error left alone
+    dead_band_y: float = 0.16  # normalised vertical image error left alone
+    approach_size: float = 0.19  # apparent size (fraction of frame width) at which approach stops
+    retreat_size: float = 0.14  # hysteresis: below this, approach again
+    aim_tolerance: float = 0.05  # normalised error within which the aim counts as centred
+    aim_frames: int = 3  # centred frames before the laser goes on
+    fire_ms: int = 1500  # laser on time
+    takeoff_ms: int = 2500  # climb time after arming
+    settle_ms: int = 500  # hold after take-off
+    search_max_ms: int = 20000  # bounded sweep: give up and land after this
+    land_ms: int = 3000  # descend time before disarming
+    arm_margin_ms: int = 300  # wait beyond the firmware's arming hold
+    horizontal_fov_deg: float = 60.0  # camera field of view, for pan/tilt corrections
+
+
+@dataclass(frozen=True)
+class LinkConfig:
+    rate_hz: float = 20.0
+    keepalive_fraction: float = 0.4  # keep-alive period as a fraction of the firmware's command timeout
+    ready_timeout_s: float = 5.0
+    reconnect_s: float = 3.0  # how long to try to reopen a lost port before giving up
+
+
+@dataclass(frozen=True)
+class PilotConfig:
+    detector: str = "hsv"
+    hsv: HsvConfig = field(default_factory=HsvConfig)
+    aruco: ArucoConfig = field(default_factory=ArucoConfig)
+    controller: ControllerConfig = field(default_factory=ControllerConfig)
+    link: LinkConfig = field(default_factory=LinkConfig)
+
+
+DETECTORS = ("hsv", "aruco")
+
+T = TypeVar("T")
+
+
+def _convert(value: Any, tp: Any, path: str, where: str) -> Any:
+    origin = typing.get_origin(tp)
+    if dataclasses.is_dataclass(tp) and isinstance(tp, type):
+        if not isinstance(value, dict):
+            raise ConfigError(f"{where}: option {path!r} must be a mapping, got {value!r}")
+        return _build(tp, value, path, where)
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise ConfigError(f"{where}: option {path!r} must be true or false, got {value!r}")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"{where}: option {path!r} must be an integer, got {value!r}")
+        return value
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ConfigError(f"{where}: option {path!r} must be a number, got {value!r}")
+        return float(value)
+    if tp is str:
+        if not isinstance(value, str):
+            raise ConfigError(f"{where}: option {path!r} must be a string, got {value!r}")
+        return value
+    if origin is tuple:
+        args = typing.get_args(tp)
+        if not isinstance(value, (list, tuple)):
+            raise ConfigError(f"{where}: option {path!r} must be a list, got {value!r}")
+        if len(args) == 2 and args[1] is Ellipsis:
+            return tuple(_convert(v, args[0], f"{path}[{i}]", where) for i, v in enumerate(value))
+        if len(value) != len(args):
+            raise ConfigError(
+                f"{where}: option {path!r} must have {len(args)} items, got {len(value)}: {value!r}"
+            )
+        return tuple(_convert(v, a, f"{path}[{i}]", where) for i, (v, a) in enumerate(zip(value, args)))
+    if isinstance(tp, types.UnionType):  # pragma: no cover - not used by the config today
+        raise ConfigError(f"{where}: option {path!r} has an unsupported type")
+    raise ConfigError(f"{where}: option {path!r} has an unsupported type {tp!r}")
+
+
+def _build(cls: type[T], data: dict[str, Any], prefix: str, where: str) -> T:
+    hints = typing.get_type_hints(cls)
+    names = {f.name for f in dataclasses.fields(cls)}  # type: ignore[arg-type]
+    for key in data:
+        if key not in names:
+            path = f"{prefix}.{key}" if prefix else str(key)
+            raise ConfigError(
+                f"{where}: unknown option {path!r}; known options here: {', '.join(sorted(names))}"
+            )
+    kwargs = {
+        key: _convert(value, hints[key], f"{prefix}.{key}" if prefix else key, where)
+        for key, value in data.items()
+    }
+    return cls(**kwargs)
+
+
+def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
+    """Check value ranges; raise ConfigError naming the option."""
+    if config.detector not in DETECTORS:
+        raise ConfigError(f"{where}: option 'detector' must be one of {DETECTORS}, got {config.detector!r}")
+    for i, (lo, hi) in enumerate(config.hsv.ranges):
+        for name, triple in (("low", lo), ("high", hi)):
+            h, s, v = triple
+            if not (0 <= h <= 179 and 0 <= s <= 255 and 0 <= v <= 255):
+                raise ConfigError(
+                    f"{where}: option 'hsv.ranges[{i}]' {name} {triple} out of range (H 0..179, S,V 0..255)"
+                )
+    if not config.hsv.ranges:
+        raise ConfigError(f"{where}: option 'hsv.ranges' must hold at least one range")
+    if config.hsv.open_kernel < 1:
+        raise ConfigError(f"{where}: option 'hsv.open_kernel' must be >= 1, got {config.hsv.open_kernel}")
+    c = config.controller
+    if c.retreat_size >= c.approach_size:
+        raise ConfigError(
+            f"{where}: option 'controller.retreat_size' ({c.retreat_size}) must be below "
+            f"'controller.approach_size' ({c.approach_size}) for the hysteresis to work"
+        )
+    for name in ("acquire_frames", "lost_frames", "aim_frames", "fire_ms"):
+        if getattr(c, name) < 1:
+            raise ConfigError(f"{where}: option 'controller.{name}' must be >= 1, got {getattr(c, name)}")
+    if not 1.0 <= config.link.rate_hz <= 50.0:
+        raise ConfigError(f"{where}: option 'link.rate_hz' must be within 1..50, got {config.link.rate_hz}")
+    if not 0.0 < config.link.keepalive_fraction < 1.0:
+        raise ConfigError(
+            f"{where}: option 'link.keepalive_fraction' must be within (0, 1), got {config.link.keepalive_fraction}"
+        )
+    return config
+
+
+def from_dict(data: dict[str, Any], where: str = "config") -> PilotConfig:
+    return validate(_build(PilotConfig, data, "", where), where)
+
+
+def load(path: str | Path) -> PilotConfig:
+    where = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError(f"{where}: cannot read config: {exc.strerror}") from exc
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"{where}: not valid YAML: {exc}") from exc
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise ConfigError(f"{where}: the top level must be a mapping of options")
+    return from_dict(data, where)
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, tuple):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    return value
+
+
+def to_dict(config: PilotConfig) -> dict[str, Any]:
+    result: dict[str, Any] = _plain(dataclasses.asdict(config))
+    return result
+
+
+def save(config: PilotConfig, path: str | Path) -> None:
+    Path(path).write_text(yaml.safe_dump(to_dict(config), sort_keys=False), encoding="utf-8")

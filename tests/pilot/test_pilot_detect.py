@@ -1,0 +1,118 @@
+from __future__ import annotations
+
+import itertools
+
+import cv2
+import pytest
+
+from pilot.config import ArucoConfig, HsvConfig
+from pilot.detect import ArucoMarkerDetector, HsvBlobDetector
+import pilot_synth as synth
+
+SIZES = [(320, 240), (640, 480)]
+
+
+@pytest.mark.parametrize("width,height", SIZES)
+@pytest.mark.parametrize("gain,noise", [(1.0, 0.0), (0.6, 0.0), (1.3, 0.0), (1.0, 8.0), (0.7, 6.0)])
+def test_hsv_position_and_size_across_frame(width: int, height: int, gain: float, noise: float) -> None:
+    det = HsvBlobDetector(HsvConfig())
+    bg = synth.background(width, height)
+    checked = 0
+    for fx, fy, radius in itertools.product((0.15, 0.5, 0.85), (0.2, 0.5, 0.8), (5, 12, 30)):
+        cx, cy = int(fx * width), int(fy * height)
+        img = synth.red_disc(bg, cx, cy, radius, gain, noise, seed=checked)
+        d = det.detect(img)
+        assert d.found, (cx, cy, radius, gain, noise)
+        assert abs(d.cx - cx) <= 1.5 and abs(d.cy - cy) <= 1.5, (d, cx, cy)
+        assert abs(d.size - 2 * radius) <= 3.0, (d.size, radius)
+        assert d.confidence > (0.85 if radius >= 12 else 0.6)
+        assert (d.width, d.height) == (width, height)
+        checked += 1
+    assert checked == 27
+
+
+def test_hsv_picks_largest_red_blob_and_ignores_speckle() -> None:
+    det = HsvBlobDetector(HsvConfig())
+    img = synth.background(320, 240)
+    cv2.circle(img, (60, 60), 8, synth.RED, -1)
+    cv2.circle(img, (200, 150), 20, synth.RED, -1)
+    img[10, 300] = synth.RED  # single pixel: removed by the opening
+    d = det.detect(img)
+    assert d.found and abs(d.cx - 200) <= 1 and abs(d.cy - 150) <= 1
+
+
+def test_hsv_min_area() -> None:
+    det = HsvBlobDetector(HsvConfig(min_area=200))
+    bg = synth.background(320, 240)
+    assert not det.detect(synth.red_disc(bg, 100, 100, 5)).found  # area ~78 < 200
+    assert det.detect(synth.red_disc(bg, 100, 100, 10)).found
+
+
+@pytest.mark.parametrize("width,height", SIZES)
+@pytest.mark.parametrize("gain", [0.6, 1.0, 1.3])
+def test_hsv_no_detection_with_only_distractors(width: int, height: int, gain: float) -> None:
+    det = HsvBlobDetector(HsvConfig())
+    img = synth.background(width, height)
+    for i, colour in enumerate(synth.DISTRACTORS.values()):
+        cv2.circle(img, (40 + i * (width // 6), height // 2), width // 16, colour, -1)
+        cv2.rectangle(img, (20 + i * (width // 6), 10), (50 + i * (width // 6), 40), colour, -1)
+    img = synth.degrade(img, gain, 6.0, seed=3)
+    d = det.detect(img)
+    assert not d.found, d
+
+
+def test_hsv_both_hue_ranges_are_needed() -> None:
+    """A red at hue ~2 and one at hue ~176: each is found only through its own range."""
+    bg = synth.background(320, 240)
+    low_red = bg.copy()
+    cv2.circle(low_red, (100, 100), 15, (10, 20, 220), -1)  # hue near 2
+    high_red = bg.copy()
+    cv2.circle(high_red, (100, 100), 15, (60, 10, 220), -1)  # hue near 172..176
+    hsv_low = cv2.cvtColor(low_red, cv2.COLOR_BGR2HSV)[100, 100]
+    hsv_high = cv2.cvtColor(high_red, cv2.COLOR_BGR2HSV)[100, 100]
+    assert hsv_low[0] < 10 and hsv_high[0] > 170
+    cfg = HsvConfig()
+    both = HsvBlobDetector(cfg)
+    only_first = HsvBlobDetector(HsvConfig(ranges=cfg.ranges[:1]))
+    only_second = HsvBlobDetector(HsvConfig(ranges=cfg.ranges[1:]))
+    assert both.detect(low_red).found and both.detect(high_red).found
+    assert only_first.detect(low_red).found and not only_first.detect(high_red).found
+    assert only_second.detect(high_red).found and not only_second.detect(low_red).found
+
+
+def test_detection_errors_normalised() -> None:
+    det = HsvBlobDetector(HsvConfig())
+    d = det.detect(synth.red_disc(synth.background(320, 240), 240, 60, 10))
+    assert d.error_x == pytest.approx(0.5, abs=0.01)
+    assert d.error_y == pytest.approx(-0.5, abs=0.01)
+    assert d.relative_size == pytest.approx(20 / 320, abs=0.01)
+
+
+@pytest.mark.parametrize("width,height", SIZES)
+@pytest.mark.parametrize("gain,noise", [(1.0, 0.0), (0.6, 4.0), (1.2, 6.0)])
+def test_aruco_position_and_size(width: int, height: int, gain: float, noise: float) -> None:
+    det = ArucoMarkerDetector(ArucoConfig(dictionary="DICT_4X4_50", marker_id=7))
+    bg = synth.background(width, height)
+    checked = 0
+    for fx, fy, side in itertools.product((0.25, 0.5, 0.75), (0.3, 0.7), (36, 60)):
+        cx, cy = int(fx * width), int(fy * height)
+        img = synth.degrade(
+            synth.paste_marker(bg, synth.marker_image(cv2.aruco.DICT_4X4_50, 7, side), cx, cy), gain, noise, checked
+        )
+        d = det.detect(img)
+        assert d.found, (cx, cy, side)
+        # the marker occupies pixels [x0, x0 + side): its centre is half a pixel before x0 + side / 2
+        assert abs(d.cx - (cx - 0.5)) <= 2.0 and abs(d.cy - (cy - 0.5)) <= 2.0, (d, cx, cy)
+        assert abs(d.size - side) <= 3.0, (d.size, side)
+        checked += 1
+    assert checked == 12
+
+
+def test_aruco_ignores_other_ids_and_distractors() -> None:
+    det = ArucoMarkerDetector(ArucoConfig(dictionary="DICT_4X4_50", marker_id=7))
+    bg = synth.background(320, 240)
+    other = synth.paste_marker(bg, synth.marker_image(cv2.aruco.DICT_4X4_50, 3, 60), 160, 120)
+    assert not det.detect(other).found
+    assert ArucoMarkerDetector(ArucoConfig(marker_id=-1)).detect(other).found
+    red_only = synth.red_disc(bg, 160, 120, 30)
+    assert not det.detect(red_only).found
