@@ -34,7 +34,7 @@ def red_disc(bg: Image, cx: int, cy: int, radius: int, gain: float = 1.0, noise:
 def degrade(img: Image, gain: float, noise: float, seed: int) -> Image:
     out = img
     if gain != 1.0:
-        out = cv2.convertScaleAbs(out, alpha=gain, beta=0.0)
+        out = np.asarray(cv2.convertScaleAbs(out, alpha=gain, beta=0.0), dtype=np.uint8)
     if noise > 0:
         rng = np.random.default_rng(seed)
         n = rng.normal(0.0, noise, out.shape)

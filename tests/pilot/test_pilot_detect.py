@@ -3,11 +3,11 @@ from __future__ import annotations
 import itertools
 
 import cv2
+import pilot_synth as synth
 import pytest
 
 from pilot.config import ArucoConfig, HsvConfig
 from pilot.detect import ArucoMarkerDetector, HsvBlobDetector
-import pilot_synth as synth
 
 SIZES = [(320, 240), (640, 480)]
 
