@@ -1,0 +1,582 @@
+"""Validate the loaded spec and build the typed model, collecting every error with its location."""
+
+from __future__ import annotations
+
+import difflib
+import hashlib
+import json
+import re
+from collections.abc import Callable
+from pathlib import Path
+from typing import TypeVar
+
+from generator import __version__
+from generator.errors import SpecError, SpecInvalid
+from generator.model import Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
+from generator.names import identifier_problem
+from generator.source import Node, load
+
+T = TypeVar("T")
+
+# Parser errors the generated code raises itself; the spec gives their codes and descriptions.
+PARSER_ERRORS = ("bad_category", "bad_direction", "bad_digit", "out_of_range", "too_short", "too_long", "timeout")
+# The ones decode() and encode() raise (timeout is the stream's alone).
+FRAME_ERRORS = tuple(e for e in PARSER_ERRORS if e != "timeout")
+REPLIES = ("ready", "accepted", "rejected", "failsafe")
+SPEED_LABELS = ("low", "median", "high")
+_BAD_TEXT = re.compile(r"[\x00-\x1f\x7f\\]|\?\?|\"\"\"")
+
+
+class Reader:
+    """Typed access to one mapping of the spec; records errors instead of raising."""
+
+    def __init__(self, node: Node, path: str, errors: list[SpecError]) -> None:
+        self.node, self.path, self.errors = node, path, errors
+        self.seen: set[str] = set()
+        self.ok = isinstance(node.value, dict)
+        if not self.ok:
+            self.error(node, f"expected a mapping, found {_kind(node.value)}")
+
+    def sub(self, key: str) -> str:
+        return f"{self.path}.{key}" if self.path else key
+
+    def error(self, node: Node, message: str, hint: str = "", path: str | None = None) -> None:
+        self.errors.append(SpecError(node.location, self.path if path is None else path, message, hint))
+
+    def child(self, key: str, required: bool = True) -> Node | None:
+        self.seen.add(key)
+        if not self.ok:
+            return None
+        node = self.node.children.get(key)
+        if node is None and required:
+            self.error(self.node, f"missing key '{key}'", path=self.sub(key))
+        return node
+
+    def get(self, key: str, kind: type[T], default: T | None = None, required: bool = True) -> T | None:
+        node = self.child(key, required and default is None)
+        if node is None:
+            return default
+        value = node.value
+        if (kind is int and isinstance(value, bool)) or not isinstance(value, kind):
+            self.error(node, f"expected {_type_name(kind)}, found {_kind(value)} {value!r}", path=self.sub(key))
+            return default
+        if isinstance(value, str) and kind is str:
+            problem = text_problem(value)
+            if problem:
+                self.error(node, problem, "write plain text; it is printed into C++ and Python code",
+                           path=self.sub(key))
+                return default
+        return value  # type: ignore[return-value]  # isinstance(value, kind) was checked above
+
+    def text(self, key: str, default: str | None = None) -> str:
+        value = self.get(key, str, default)
+        return " ".join(value.split()) if value is not None else ""
+
+    def integer(self, key: str, default: int | None = None) -> int:
+        value = self.get(key, int, default)
+        return value if value is not None else 0
+
+    def mapping(self, key: str, required: bool = True) -> Reader | None:
+        node = self.child(key, required)
+        return Reader(node, self.sub(key), self.errors) if node is not None else None
+
+    def entries(self, key: str) -> list[tuple[str, Node]]:
+        node = self.child(key)
+        if node is None:
+            return []
+        if not isinstance(node.value, dict):
+            self.error(node, f"expected a mapping, found {_kind(node.value)}", path=self.sub(key))
+            return []
+        if not node.children:
+            self.error(node, "must not be empty", path=self.sub(key))
+        return list(node.children.items())
+
+    def finish(self) -> None:
+        """Report keys nobody asked for, with the nearest known key as a hint."""
+        if not self.ok:
+            return
+        for key, node in self.node.children.items():
+            if key not in self.seen:
+                near = difflib.get_close_matches(key, sorted(self.seen), n=1)
+                hint = f"did you mean '{near[0]}'?" if near else "known keys: " + ", ".join(sorted(self.seen))
+                self.errors.append(SpecError(node.key_location, self.sub(key), f"unknown key '{key}'", hint))
+
+
+def text_problem(value: str) -> str | None:
+    bad = _BAD_TEXT.search(value.replace("\n", " "))
+    if bad is None:
+        return None
+    return f"text contains {bad.group()!r}, which could break out of a comment or string in generated code"
+
+
+def _kind(value: object) -> str:
+    if value is None:
+        return "nothing"
+    return {bool: "a boolean", int: "an integer", float: "a number", str: "text", list: "a list",
+            dict: "a mapping"}.get(type(value), type(value).__name__)
+
+
+def _type_name(kind: type) -> str:
+    return {int: "an integer", str: "text", bool: "a boolean", list: "a list", dict: "a mapping"}[kind]
+
+
+def fingerprint(value: object) -> str:
+    canonical = json.dumps(value, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
+    return hashlib.sha256(canonical.encode("ascii")).hexdigest()
+
+
+def load_spec(path: Path) -> Spec:
+    """Read, validate and build the model of the spec at `path`; raise SpecInvalid with every error."""
+    name = path.name
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        from generator.errors import Location
+
+        raise SpecInvalid([SpecError(Location(str(path), 1, 1), "", f"cannot read the spec: {exc}")]) from exc
+    root, errors = load(text, str(path))
+    if root is None:
+        raise SpecInvalid(errors)
+    spec = _Builder(root, name, errors).build()
+    if errors or spec is None:
+        raise SpecInvalid(errors)
+    return spec
+
+
+class _Builder:
+    def __init__(self, root: Node, source_name: str, errors: list[SpecError]) -> None:
+        self.root, self.source_name, self.errors = root, source_name, errors
+
+    def build(self) -> Spec | None:
+        top = Reader(self.root, "", self.errors)
+        if not top.ok:
+            return None
+        protocol = top.mapping("protocol")
+        frame = top.mapping("frame")
+        link = top.mapping("link")
+        safety = top.mapping("safety")
+        modes = top.mapping("flight_modes")
+        speeds = top.mapping("speeds")
+        if not (protocol and frame and link and safety and modes and speeds):
+            top.finish()
+            return None
+
+        name = protocol.text("name")
+        self._identifier(protocol, "name", name)
+        version = protocol.integer("version")
+        title = protocol.text("title")
+        description = protocol.text("description")
+        protocol.finish()
+
+        length = frame.integer("length")
+        encoding = frame.get("encoding", str)
+        if encoding is not None and encoding != "ascii":
+            frame.error(frame.node.children["encoding"], f"unsupported encoding '{encoding}'", "only ascii",
+                        frame.sub("encoding"))
+        if length is not None and not 3 <= length <= 8:
+            frame.error(frame.node.children["length"], f"frame length {length} is not in 3..8",
+                        "a frame is category, direction and 1 to 6 value digits", frame.sub("length"))
+        inter_byte = self._positive(frame, "inter_byte_timeout_ms")
+        frame.finish()
+
+        baud = self._positive(link, "baud")
+        data_bits = link.integer("data_bits", 8)
+        parity = link.text("parity", "none")
+        if parity not in ("none", "even", "odd"):
+            link.error(link.node.children["parity"], f"unknown parity '{parity}'", "none, even or odd",
+                       link.sub("parity"))
+        stop_bits = link.integer("stop_bits", 1)
+        ready_timeout = self._positive(link, "ready_timeout_ms")
+        link.finish()
+
+        step = self._positive(speeds, "step_us")
+        speeds.finish()
+        channels = self._channels(top, step)
+        servos = self._servos(top)
+        fields = self._fields(top, length)
+
+        stabilize = self._positive(modes, "stabilize_us")
+        alt_hold = self._positive(modes, "alt_hold_us")
+        modes.finish()
+        command_timeout = self._positive(safety, "command_timeout_ms")
+        failsafe_timeout = self._positive(safety, "failsafe_timeout_ms")
+        failsafe_throttle = self._positive(safety, "failsafe_throttle_us")
+        arming_hold = self._positive(safety, "arming_hold_ms")
+        if command_timeout and failsafe_timeout and command_timeout > failsafe_timeout:
+            safety.error(safety.node.children["command_timeout_ms"],
+                         "command_timeout_ms is longer than failsafe_timeout_ms",
+                         "a movement must end before the failsafe fires", safety.sub("command_timeout_ms"))
+        safety.finish()
+
+        categories = self._categories(top, fields, channels, servos, length)
+        replies = self._replies(top)
+        errors = self._errors(top)
+        settled = self._settled(top)
+        top.finish()
+        if self.errors:
+            return None
+        return Spec(
+            source_name=self.source_name,
+            fingerprint=fingerprint(self.root.value),
+            generator_version=__version__,
+            name=name,
+            version=version,
+            title=title,
+            description=description,
+            frame_length=length,
+            inter_byte_timeout_ms=inter_byte,
+            baud=baud,
+            data_bits=data_bits,
+            parity=parity,
+            stop_bits=stop_bits,
+            ready_timeout_ms=ready_timeout,
+            channels=tuple(channels.values()),
+            speed_step_us=step,
+            servos=tuple(servos.values()),
+            mode_stabilize_us=stabilize,
+            mode_alt_hold_us=alt_hold,
+            command_timeout_ms=command_timeout,
+            failsafe_timeout_ms=failsafe_timeout,
+            failsafe_throttle_us=failsafe_throttle,
+            arming_hold_ms=arming_hold,
+            fields=tuple(f for f, _, _, _ in fields.values()),
+            categories=tuple(categories),
+            replies=tuple(replies),
+            errors=tuple(errors),
+            settled=tuple(settled),
+        )
+
+    # -- helpers -------------------------------------------------------------------------------------------
+
+    def _positive(self, reader: Reader, key: str) -> int:
+        value = reader.integer(key)
+        node = reader.node.children.get(key) if reader.ok else None
+        if node is not None and isinstance(value, int) and value <= 0:
+            reader.error(node, f"{key} must be positive, found {value}", path=reader.sub(key))
+        return value
+
+    def _identifier(self, reader: Reader, key: str, name: str, python_only: bool = False) -> bool:
+        node = reader.node.children.get(key) if reader.ok else None
+        if node is None or not name:
+            return False
+        problem = identifier_problem(name, python_only)
+        if problem:
+            reader.error(node, problem, "names become Python and C++ identifiers", reader.sub(key))
+            return False
+        return True
+
+    def _pair(self, reader: Reader, key: str) -> tuple[int, int] | None:
+        node = reader.child(key)
+        if node is None:
+            return None
+        value = node.value
+        if (not isinstance(value, list) or len(value) != 2
+                or not all(isinstance(v, int) and not isinstance(v, bool) for v in value)):
+            reader.error(node, f"expected [min, max] as two integers, found {value!r}", path=reader.sub(key))
+            return None
+        lo, hi = int(value[0]), int(value[1])  # type: ignore[arg-type]
+        if lo > hi:
+            reader.error(node, f"minimum {lo} is greater than maximum {hi}", "write [min, max]", reader.sub(key))
+            return None
+        if lo < 0:
+            reader.error(node, f"minimum {lo} is negative", "values are unsigned decimal digits", reader.sub(key))
+            return None
+        return lo, hi
+
+    def _named_entries(self, top: Reader, key: str) -> list[tuple[str, Reader]]:
+        out = []
+        for entry, node in top.entries(key):
+            reader = Reader(node, top.sub(key) + "." + entry, self.errors)
+            problem = identifier_problem(entry)
+            if problem:
+                self.errors.append(SpecError(node.key_location, reader.path, problem,
+                                             "names become Python and C++ identifiers"))
+            elif reader.ok:
+                out.append((entry, reader))
+        return out
+
+    def _channels(self, top: Reader, step: int) -> dict[str, Channel]:
+        channels: dict[str, Channel] = {}
+        for name, r in self._named_entries(top, "channels"):
+            pair = self._pair(r, "recorded")
+            movement = r.text("movement")
+            r.finish()
+            if pair is None:
+                continue
+            lo, hi = pair
+            median = (lo + hi + 1) // 2  # midpoint rounded half up
+            channels[name] = Channel(name, lo, hi, median, median - step, median + step, movement)
+        return channels
+
+    def _servos(self, top: Reader) -> dict[str, Servo]:
+        servos: dict[str, Servo] = {}
+        for name, r in self._named_entries(top, "servos"):
+            description = r.text("description")
+            pair = self._pair(r, "range_deg")
+            default = r.integer("default_deg")
+            r.finish()
+            if pair is None:
+                continue
+            if not pair[0] <= default <= pair[1]:
+                r.error(r.node.children["default_deg"], f"default {default} is outside range {pair[0]}..{pair[1]}",
+                        path=r.sub("default_deg"))
+            servos[name] = Servo(name, description, pair[0], pair[1], default)
+        return servos
+
+    def _fields(self, top: Reader, length: int) -> dict[str, tuple[Field, tuple[int, int] | None, int | None, Node]]:
+        fields: dict[str, tuple[Field, tuple[int, int] | None, int | None, Node]] = {}
+        for name, r in self._named_entries(top, "fields"):
+            width = r.integer("width")
+            unit = r.text("unit")
+            description = r.text("description")
+            pair = self._pair(r, "range") if r.node.children.get("range") is not None else None
+            r.seen.add("range")
+            default = r.get("default", int, required=False)
+            parameter = r.text("parameter", "")
+            if parameter:
+                self._identifier(r, "parameter", parameter, python_only=True)
+            r.finish()
+            if width and length and width != length - 2:
+                r.error(r.node.children["width"], f"width {width} does not fill the frame",
+                        f"frame.length {length} leaves {length - 2} value digits", r.sub("width"))
+            if pair and width and pair[1] >= 10 ** width:
+                r.error(r.node.children["range"], f"maximum {pair[1]} does not fit in {width} digits",
+                        f"at most {10 ** width - 1}", r.sub("range"))
+            if default is not None and pair and not pair[0] <= default <= pair[1]:
+                r.error(r.node.children["default"], f"default {default} is outside range {pair[0]}..{pair[1]}",
+                        path=r.sub("default"))
+            if not parameter and not (pair and pair[0] == pair[1]):
+                r.error(r.node, "missing key 'parameter'", "a field with a range of values needs an argument name",
+                        r.sub("parameter"))
+            fields[name] = (Field(name, width, unit, description, parameter), pair, default, r.node)
+        return fields
+
+    def _categories(self, top: Reader, fields: dict[str, tuple[Field, tuple[int, int] | None, int | None, Node]],
+                    channels: dict[str, Channel], servos: dict[str, Servo], length: int) -> list[Category]:
+        categories: list[Category] = []
+        commands: dict[str, str] = {}
+        for code, node in top.entries("categories"):
+            path = f"categories.{code}"
+            if not _is_code(code):
+                self.errors.append(SpecError(node.key_location, path, f"category code {code!r} is not one printable "
+                                             "ASCII character", "use one letter, e.g. 'm'"))
+                continue
+            if code.isdigit():
+                self.errors.append(SpecError(node.key_location, path, f"category code '{code}' is a digit",
+                                             "a digit would be mistaken for a value byte when resynchronising"))
+                continue
+            r = Reader(node, path, self.errors)
+            if not r.ok:
+                continue
+            name = r.text("name")
+            name_ok = self._identifier(r, "name", name)
+            hardware = r.text("hardware")
+            description = r.text("description")
+            default_field = r.get("field", str, required=False)
+            filler_code = r.get("filler", str, required=False)
+            prefix = r.get("command_prefix", str, required=False)
+            if prefix is None:
+                prefix = f"{name}_"
+            if default_field is not None and default_field not in fields:
+                self._unknown(r, "field", default_field, fields)
+            directions = []
+            for dcode, dnode in r.entries("directions"):
+                d = self._direction(r, code, dcode, dnode, prefix, default_field, filler_code, fields, channels,
+                                    servos)
+                if d is None:
+                    continue
+                if d.command in commands:
+                    self.errors.append(SpecError(dnode.location, f"{path}.directions.{dcode}",
+                                                 f"command name '{d.command}' is already used by "
+                                                 f"{commands[d.command]}", "rename the direction"))
+                    continue
+                commands[d.command] = f"{code}{dcode}"
+                directions.append(d)
+            if filler_code is not None and len(directions) != 1:
+                r.error(r.node.children["filler"], "a category with a filler byte has exactly one direction",
+                        path=r.sub("filler"))
+            r.finish()
+            if name_ok:
+                categories.append(Category(code, name, hardware, description, tuple(directions),
+                                           filler_code is not None))
+        seen: dict[str, str] = {}
+        for cat in categories:
+            if cat.name in seen or cat.name in commands:
+                node = top.node.children["categories"].children[cat.code].children["name"]
+                self.errors.append(SpecError(node.location, f"categories.{cat.code}.name",
+                                             f"name '{cat.name}' is already used",
+                                             "category and command names must all differ"))
+            seen[cat.name] = cat.code
+        return categories
+
+    def _unknown(self, r: Reader, key: str, value: str, known: dict[str, T]) -> None:
+        near = difflib.get_close_matches(value, sorted(known), n=1)
+        hint = f"did you mean '{near[0]}'?" if near else "known: " + ", ".join(sorted(known))
+        r.error(r.node.children[key], f"unknown {key} '{value}'", hint, r.sub(key))
+
+    def _direction(self, cat: Reader, code: str, dcode: str, node: Node, prefix: str, default_field: str | None,
+                   filler_code: str | None, fields: dict[str, tuple[Field, tuple[int, int] | None, int | None, Node]],
+                   channels: dict[str, Channel], servos: dict[str, Servo]) -> Direction | None:
+        path = f"{cat.path}.directions.{dcode}"
+        if not _is_code(dcode):
+            self.errors.append(SpecError(node.key_location, path, f"direction code {dcode!r} is not one printable "
+                                         "ASCII character", "use one letter, e.g. 'f'"))
+            return None
+        if filler_code is not None and dcode != filler_code:
+            self.errors.append(SpecError(node.key_location, path, f"direction '{dcode}' differs from the "
+                                         f"category's filler '{filler_code}'"))
+            return None
+        r = Reader(node, path, self.errors)
+        if not r.ok:
+            return None
+        name = r.text("name")
+        name_ok = self._identifier(r, "name", name)
+        description = r.text("description")
+        field_name = r.get("field", str, default_field)
+        channel_name = r.get("channel", str, required=False)
+        servo_name = r.get("servo", str, required=False)
+        sense = r.get("sense", int, required=False)
+        routine = r.text("routine", "")
+        default_node = r.node.children.get("default")
+        r.seen.add("default")
+        r.finish()
+        if field_name is None:
+            r.error(r.node, "missing key 'field'", "give the direction or its category a field", r.sub("field"))
+            return None
+        if field_name not in fields:
+            if "field" in r.node.children:
+                self._unknown(r, "field", field_name, fields)
+            return None
+        fld, pair, fdefault, _ = fields[field_name]
+        target, label, default = "none", "", fdefault
+        if channel_name is not None:
+            if channel_name not in channels:
+                self._unknown(r, "channel", channel_name, channels)
+                return None
+            channel = channels[channel_name]
+            target = channel_name
+            if pair is None:
+                pair = (channel.recorded_min, channel.recorded_max)
+        if servo_name is not None:
+            if servo_name != "both" and servo_name not in servos:
+                self._unknown(r, "servo", servo_name, {**servos, "both": None})
+                return None
+            target = servo_name
+        if servo_name is not None and channel_name is not None:
+            r.error(r.node, "a direction drives a channel or a servo, not both", path=path)
+            return None
+        if sense is not None and sense not in (-1, 1):
+            r.error(r.node.children["sense"], f"sense must be 1 or -1, found {sense}", path=r.sub("sense"))
+        if pair is None:
+            r.error(r.node, f"field '{field_name}' has no range and the direction drives no channel",
+                    "give the field a range or the direction a channel", path)
+            return None
+        if default_node is not None:
+            value = default_node.value
+            if isinstance(value, str) and channel_name is not None:
+                if value not in SPEED_LABELS:
+                    near = difflib.get_close_matches(value, SPEED_LABELS, n=1)
+                    r.error(default_node, f"unknown speed '{value}'",
+                            f"did you mean '{near[0]}'?" if near else "low, median or high", r.sub("default"))
+                    return None
+                label, default = value, channels[channel_name].speed(value)
+            elif isinstance(value, int) and not isinstance(value, bool):
+                default = value
+            else:
+                r.error(default_node, f"expected an integer or low/median/high, found {value!r}",
+                        path=r.sub("default"))
+                return None
+        if pair[1] >= 10 ** fld.width:
+            r.error(r.node, f"range {pair[0]}..{pair[1]} does not fit in {fld.width} digits", path=path)
+            return None
+        if default is not None and not pair[0] <= default <= pair[1]:
+            where = default_node if default_node is not None else r.node
+            r.error(where, f"default {default} is outside range {pair[0]}..{pair[1]}", path=r.sub("default"))
+            return None
+        if not name_ok:
+            return None
+        command = f"{prefix}{name}"
+        problem = identifier_problem(command)
+        if problem:
+            r.error(r.node.children["name"], problem, "change the name or the category's command_prefix",
+                    r.sub("name"))
+            return None
+        return Direction(dcode, name, command, description, fld, pair[0], pair[1], default, label, target,
+                         sense or 0, routine, filler_code is not None)
+
+    def _replies(self, top: Reader) -> list[Reply]:
+        replies = []
+        for name, node in top.entries("replies"):
+            r = Reader(node, f"replies.{name}", self.errors)
+            if name not in REPLIES:
+                near = difflib.get_close_matches(name, REPLIES, n=1)
+                self.errors.append(SpecError(node.key_location, r.path, f"unknown reply '{name}'",
+                                             f"did you mean '{near[0]}'?" if near else "known: " + ", ".join(REPLIES)))
+                continue
+            prefix = r.text("prefix")
+            description = r.text("description")
+            r.finish()
+            if prefix and not all(_is_code(c) and c not in "\n" for c in prefix):
+                r.error(r.node.children["prefix"], f"prefix {prefix!r} is not printable ASCII", path=r.sub("prefix"))
+            replies.append(Reply(name, prefix, description))
+        self._require_all(top, "replies", REPLIES, {r.name for r in replies})
+        prefixes = [r.prefix for r in replies]
+        for reply in replies:
+            clash = [p for p in prefixes if p != reply.prefix and p.startswith(reply.prefix)]
+            if clash:
+                node = top.node.children["replies"].children[reply.name]
+                self.errors.append(SpecError(node.location, f"replies.{reply.name}.prefix",
+                                             f"prefix '{reply.prefix}' is the start of '{clash[0]}'",
+                                             "reply prefixes must not be prefixes of each other"))
+        return replies
+
+    def _errors(self, top: Reader) -> list[ErrorKind]:
+        kinds: list[ErrorKind] = []
+        codes: dict[str, str] = {}
+        for name, r in self._named_entries(top, "errors"):
+            code = r.text("code")
+            description = r.text("description")
+            r.finish()
+            if not _is_code(code) or not code.isalnum():
+                r.error(r.node.children.get("code", r.node), f"error code {code!r} is not one letter or digit",
+                        path=r.sub("code"))
+                continue
+            if code in codes:
+                r.error(r.node.children["code"], f"error code '{code}' is already used by {codes[code]}",
+                        path=r.sub("code"))
+                continue
+            codes[code] = name
+            kinds.append(ErrorKind(len(kinds) + 1, name, code, description))
+        self._require_all(top, "errors", PARSER_ERRORS, {k.name for k in kinds})
+        return kinds
+
+    def _require_all(self, top: Reader, key: str, required: tuple[str, ...], present: set[str]) -> None:
+        node = top.node.children.get(key)
+        if node is None:
+            return
+        for name in required:
+            if name not in present and name not in node.children:
+                self.errors.append(SpecError(node.location, f"{key}.{name}", f"missing {key[:-1]} '{name}'",
+                                             "the generated code relies on it"))
+
+    def _settled(self, top: Reader) -> list[Settled]:
+        node = top.child("settled", required=False)
+        if node is None:
+            return []
+        if not isinstance(node.value, list):
+            top.error(node, f"expected a list, found {_kind(node.value)}", path="settled")
+            return []
+        out = []
+        for i, item in enumerate(node.items):
+            r = Reader(item, f"settled[{i}]", self.errors)
+            if r.ok:
+                out.append(Settled(r.text("title"), r.text("seed"), r.text("decision")))
+                r.finish()
+        return out
+
+
+def _is_code(code: str) -> bool:
+    return len(code) == 1 and 0x21 <= ord(code) <= 0x7E
+
+
+Check = Callable[[Spec], None]

@@ -1,0 +1,179 @@
+"""The typed model of a validated spec. Templates print these objects and compute nothing themselves."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Channel:
+    """One RC channel of Table 4, with the derived speeds."""
+
+    name: str
+    recorded_min: int
+    recorded_max: int
+    median: int
+    low: int  # the seed's "40 % speed"
+    high: int  # the seed's "60 % speed"
+    movement: str
+
+    def speed(self, label: str) -> int:
+        return {"low": self.low, "median": self.median, "high": self.high}[label]
+
+
+@dataclass(frozen=True)
+class Servo:
+    name: str
+    description: str
+    min_deg: int
+    max_deg: int
+    default_deg: int
+
+
+@dataclass(frozen=True)
+class Field:
+    name: str
+    width: int
+    unit: str
+    description: str
+    parameter: str  # the argument name of generated functions; "" for a constant field
+
+
+@dataclass(frozen=True)
+class Direction:
+    code: str
+    name: str
+    command: str  # function / handler name, e.g. move_forward
+    description: str
+    field: Field
+    minimum: int
+    maximum: int
+    default: int | None  # None: the value must be given
+    default_label: str  # "high", "low", "" ... how the default was chosen
+    target: str  # a channel or servo name, "both" or "none"
+    sense: int  # +1 / -1 for servo moves, 0 otherwise
+    routine: str  # the seed's firmware routine for `i` commands, else ""
+    filler: bool  # the direction byte is a filler (laser), not a direction
+
+    def frame(self, category: str, value: int) -> str:
+        return f"{category}{self.code}{value:0{self.field.width}d}"
+
+    @property
+    def default_frame_value(self) -> int:
+        return self.minimum if self.default is None else self.default
+
+
+@dataclass(frozen=True)
+class Category:
+    code: str
+    name: str
+    hardware: str
+    description: str
+    directions: tuple[Direction, ...]
+    filler: bool
+
+
+@dataclass(frozen=True)
+class Command:
+    """A (category, direction) pair flattened for the templates."""
+
+    index: int
+    category: Category
+    direction: Direction
+
+
+@dataclass(frozen=True)
+class ErrorKind:
+    index: int  # 1-based; 0 is "none" in the C++ enum
+    name: str
+    code: str
+    description: str
+
+
+@dataclass(frozen=True)
+class Reply:
+    name: str
+    prefix: str
+    description: str
+
+
+@dataclass(frozen=True)
+class Settled:
+    """One inconsistency of the seed document and what the spec decides."""
+
+    title: str
+    seed: str
+    decision: str
+
+
+@dataclass(frozen=True)
+class Vector:
+    """One conformance case: a frame and what decoding it must give."""
+
+    frame: bytes
+    note: str
+    command: str  # "" when the frame is invalid
+    category: str
+    direction: str
+    value: int
+    error: str  # "" when valid
+    position: int  # byte index of the error, -1 when valid
+
+
+@dataclass(frozen=True)
+class Spec:
+    source_name: str
+    fingerprint: str  # sha256 of the canonical spec, hex
+    generator_version: str
+    name: str
+    version: int
+    title: str
+    description: str
+    frame_length: int
+    inter_byte_timeout_ms: int
+    baud: int
+    data_bits: int
+    parity: str
+    stop_bits: int
+    ready_timeout_ms: int
+    channels: tuple[Channel, ...]
+    speed_step_us: int
+    servos: tuple[Servo, ...]
+    mode_stabilize_us: int
+    mode_alt_hold_us: int
+    command_timeout_ms: int
+    failsafe_timeout_ms: int
+    failsafe_throttle_us: int
+    arming_hold_ms: int
+    fields: tuple[Field, ...]
+    categories: tuple[Category, ...]
+    replies: tuple[Reply, ...]
+    errors: tuple[ErrorKind, ...]
+    settled: tuple[Settled, ...]
+
+    @property
+    def short_fingerprint(self) -> str:
+        return self.fingerprint[:16]
+
+    @property
+    def commands(self) -> tuple[Command, ...]:
+        out: list[Command] = []
+        for cat in self.categories:
+            for d in cat.directions:
+                out.append(Command(len(out), cat, d))
+        return tuple(out)
+
+    @property
+    def targets(self) -> tuple[str, ...]:
+        """Every output a command can drive, in a stable order (C++ Target enum after None)."""
+        return tuple(c.name for c in self.channels) + tuple(s.name for s in self.servos) + ("both",)
+
+    def reply(self, name: str) -> Reply:
+        return next(r for r in self.replies if r.name == name)
+
+    def channel(self, name: str) -> Channel:
+        return next(c for c in self.channels if c.name == name)
+
+    @property
+    def digits_width(self) -> int:
+        return self.frame_length - 2

@@ -1,0 +1,19 @@
+"""The generated targets. Adding one means a template folder under templates/ and one line here."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Target:
+    name: str  # the folder of templates under generator/templates/
+    comment: str  # how its files carry the do-not-edit header: "#", "//", "<!--", or "json" (the template does)
+
+
+TARGETS: tuple[Target, ...] = (
+    Target("python", "#"),
+    Target("arduino", "//"),
+    Target("docs", "<!--"),
+    Target("vectors", "json"),
+)

@@ -1,0 +1,83 @@
+"""Conformance vectors: every command at its edges, and malformed frames with the error they must give."""
+
+from __future__ import annotations
+
+import string
+
+from generator.model import Category, Direction, Spec, Vector
+
+
+def build_vectors(spec: Spec) -> tuple[Vector, ...]:
+    out: list[Vector] = []
+    for cmd in spec.commands:
+        cat, d = cmd.category, cmd.direction
+        cases = [("minimum", d.minimum), ("maximum", d.maximum)]
+        if d.default is not None:
+            cases.append(("default", d.default))
+        for note, value in cases:
+            out.append(_valid(cat, d, value, f"{d.command} at its {note}"))
+        if d.minimum > 0:
+            out.append(_invalid(d.frame(cat.code, d.minimum - 1).encode(), "out_of_range", 2,
+                                f"{d.command} just below its minimum"))
+        if d.maximum < 10 ** d.field.width - 1:
+            out.append(_invalid(d.frame(cat.code, d.maximum + 1).encode(), "out_of_range", 2,
+                                f"{d.command} just above its maximum"))
+    out.extend(_malformed(spec))
+    return tuple(_dedupe(out))
+
+
+def _valid(cat: Category, d: Direction, value: int, note: str) -> Vector:
+    return Vector(d.frame(cat.code, value).encode(), note, d.command, cat.code, d.code, value, "", -1)
+
+
+def _invalid(frame: bytes, error: str, position: int, note: str) -> Vector:
+    return Vector(frame, note, "", "", "", 0, error, position)
+
+
+def _malformed(spec: Spec) -> list[Vector]:
+    width = spec.digits_width
+    first = spec.commands[0]
+    good = first.direction.frame(first.category.code, first.direction.default_frame_value).encode()
+    codes = {c.code for c in spec.categories}
+    out = []
+    for bad in ("x", "1", "M", " "):
+        if bad not in codes:
+            out.append(_invalid(bad.encode() + good[1:], "bad_category", 0, f"category {bad!r} does not exist"))
+    out.append(_invalid(b"\x00" + good[1:], "bad_category", 0, "a NUL byte as category"))
+    out.append(_invalid(b"\xff" + good[1:], "bad_category", 0, "a byte above ASCII as category"))
+    for cat in spec.categories:
+        taken = {d.code for d in cat.directions}
+        bad = next(c for c in "zqZ9" + string.ascii_letters if c not in taken)
+        d = cat.directions[0]
+        frame = d.frame(cat.code, d.default_frame_value).encode()
+        out.append(_invalid(frame[:1] + bad.encode() + frame[2:], "bad_direction", 1,
+                            f"direction {bad!r} is not one of category {cat.code!r}"))
+        for pos in range(2, spec.frame_length):
+            for junk in (b"a", b" ", b"-"):
+                broken = frame[:pos] + junk + frame[pos + 1:]
+                out.append(_invalid(broken, "bad_digit", pos, f"{junk.decode()!r} at byte {pos} is not a digit"))
+    for n in range(spec.frame_length):
+        out.append(_invalid(good[:n], "too_short", n, f"a frame of {n} bytes"))
+    out.append(_invalid(good + b"0", "too_long", spec.frame_length, "a frame of one byte too many"))
+    # The seed's own mistakes: the laser frame written with a '1', "mf0005 moves 5 ft", and -5 encoded.
+    for cat in spec.categories:
+        if cat.filler and "1" not in codes:
+            d = cat.directions[0]
+            out.append(_invalid(b"1" + d.frame(cat.code, d.default_frame_value).encode()[1:], "bad_category", 0,
+                                "the laser frame as the seed's code comment writes it"))
+    if not first.direction.minimum <= 5 <= first.direction.maximum:
+        out.append(_invalid(first.direction.frame(first.category.code, 5).encode(), "out_of_range", 2,
+                            "createCommand's example value 5 (a distance, not a speed)"))
+    out.append(_invalid(good[:2] + b"0" * (width - 2) + b"-5", "bad_digit", spec.frame_length - 2,
+                        "createCommand's encoding of -5"))
+    return out
+
+
+def _dedupe(vectors: list[Vector]) -> list[Vector]:
+    seen: set[bytes] = set()
+    out = []
+    for v in vectors:
+        if v.frame not in seen:
+            seen.add(v.frame)
+            out.append(v)
+    return out
