@@ -548,7 +548,10 @@ class _Builder:
             codes[code] = name
             kinds.append(ErrorKind(len(kinds) + 1, name, code, description))
         self._require_all(top, "errors", PARSER_ERRORS, {k.name for k in kinds})
-        return kinds
+        # The parser's kinds come first, in a fixed order, so generated code can count them in one array.
+        order = sorted(kinds, key=lambda k: (PARSER_ERRORS.index(k.name) if k.name in PARSER_ERRORS
+                                             else len(PARSER_ERRORS), k.index))
+        return [ErrorKind(i + 1, k.name, k.code, k.description) for i, k in enumerate(order)]
 
     def _require_all(self, top: Reader, key: str, required: tuple[str, ...], present: set[str]) -> None:
         node = top.node.children.get(key)
