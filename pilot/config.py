@@ -113,7 +113,7 @@ def _convert(value: Any, tp: Any, path: str, where: str) -> Any:
             raise ConfigError(
                 f"{where}: option {path!r} must have {len(args)} items, got {len(value)}: {value!r}"
             )
-        return tuple(_convert(v, a, f"{path}[{i}]", where) for i, (v, a) in enumerate(zip(value, args)))
+        return tuple(_convert(v, a, f"{path}[{i}]", where) for i, (v, a) in enumerate(zip(value, args, strict=False)))
     if isinstance(tp, types.UnionType):  # pragma: no cover - not used by the config today
         raise ConfigError(f"{where}: option {path!r} has an unsupported type")
     raise ConfigError(f"{where}: option {path!r} has an unsupported type {tp!r}")

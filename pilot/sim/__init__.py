@@ -1,0 +1,1 @@
+"""The simulated room, the kinematic drone model and the virtual-drone harness."""
