@@ -1,0 +1,67 @@
+# The two commands of the README:  `make demo`  and  `make test`.
+# Both install what they need: Debian packages (apt-get, when run as root; otherwise they name what to
+# install) and a Python virtual environment in .venv.
+
+SHELL := /bin/bash
+PYTHON_SYSTEM ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+VENV_STAMP := $(VENV)/.installed
+APT_STAMP := build/.apt-packages
+
+# Debian 12 packages: the AVR toolchain and Arduino core, simavr, host compilers, clang + libFuzzer, valgrind.
+APT_PACKAGES := make gcc g++ python3 python3-venv python3-pip gcc-avr binutils-avr avr-libc arduino-core-avr \
+                simavr libsimavr-dev libelf-dev pkg-config clang libclang-rt-14-dev valgrind
+
+.PHONY: all demo test deps generate check-generated lint typecheck pytest fuzz fuzz-smoke bench clean
+
+all: generate
+
+deps: $(APT_STAMP) $(VENV_STAMP)
+
+$(APT_STAMP):
+	@missing=$$(for p in $(APT_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null \
+	    | grep -q "install ok installed" || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    echo "Installing Debian packages:" $$missing; \
+	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null || exit 1; \
+	  else \
+	    echo "Missing Debian packages. Run:  sudo apt-get install -y $$missing"; exit 1; \
+	  fi; \
+	fi
+	@mkdir -p $(dir $@) && touch $@
+
+$(VENV_STAMP): pyproject.toml
+	@test -x $(PY) || $(PYTHON_SYSTEM) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -e '.[dev]'
+	@touch $@
+
+generate: $(VENV_STAMP)
+	$(PY) -m generator
+
+check-generated: $(VENV_STAMP)
+	$(PY) -m generator --check
+
+lint: $(VENV_STAMP)
+	$(VENV)/bin/ruff check --output-format concise .
+
+typecheck: $(VENV_STAMP)
+	$(VENV)/bin/mypy --strict generator generated/python/drone_protocol pilot tests bench
+
+pytest: deps
+	$(PY) -m pytest -q tests
+
+test: deps check-generated lint typecheck pytest fuzz-smoke
+
+demo: deps generate
+	$(PY) -m generator.demo
+
+-include firmware/firmware.mk
+-include pilot/pilot.mk
+-include tests/fuzz/fuzz.mk
+-include bench/bench.mk
+
+clean:
+	rm -rf build firmware/build
