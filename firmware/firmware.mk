@@ -1,0 +1,119 @@
+# Firmware builds, included by the top-level Makefile (paths are relative to
+# the repository root, which is where make runs).
+#
+#   make firmware          Uno + Mega 2560 .elf/.hex (and the Uno PPM-sum build), flash/RAM printed
+#   make firmware-host     virtual_drone and the host test programs
+#   make firmware-sim      the simavr harness
+#   make bench-firmware    flash/RAM, cycles per frame and pulse jitter vs a String-based baseline
+#
+# Overridable: DRONE_PROTOCOL_DIR (the generated Arduino library to build
+# against) and FW_BUILD (where everything goes), so a test can rebuild the
+# firmware from a regenerated spec in a temporary directory.
+
+FW_DIR := firmware
+FW_BUILD ?= $(FW_DIR)/build
+DRONE_PROTOCOL_DIR ?= generated/arduino/DroneProtocol
+ARDUINO_AVR ?= /usr/share/arduino/hardware/arduino/avr
+ARDUINO_CORE := $(ARDUINO_AVR)/cores/arduino
+
+AVR_CC ?= avr-gcc
+AVR_CXX ?= avr-g++
+AVR_OBJCOPY ?= avr-objcopy
+AVR_SIZE ?= avr-size
+HOST_CXX ?= g++
+HOST_CC ?= gcc
+
+FW_SKETCH_SRC := $(FW_DIR)/drone/drone_app.cpp $(FW_DIR)/drone/drone_logic.cpp \
+                 $(FW_DIR)/drone/pulse_schedule.cpp $(FW_DIR)/drone/pulse_out_avr.cpp
+FW_HEADERS := $(wildcard $(FW_DIR)/drone/*.h)
+FW_PROTO_SRC = $(wildcard $(DRONE_PROTOCOL_DIR)/src/*.cpp)
+FW_PROTO_HDR = $(wildcard $(DRONE_PROTOCOL_DIR)/src/*.h)
+
+FW_WARN := -Wall -Wextra -Werror
+FW_AVR_COMMON := -Os -g -ffunction-sections -fdata-sections -flto -DF_CPU=16000000L -DARDUINO=10819 \
+                 -DARDUINO_ARCH_AVR
+FW_AVR_CFLAGS := -std=gnu11 -fno-fat-lto-objects
+FW_AVR_CXXFLAGS := -std=gnu++11 -fno-exceptions -fno-threadsafe-statics -DDECIMAL_DIG=__DECIMAL_DIG__
+
+FW_CORE_C := $(wildcard $(ARDUINO_CORE)/*.c)
+FW_CORE_CXX := $(wildcard $(ARDUINO_CORE)/*.cpp)
+FW_CORE_S := $(wildcard $(ARDUINO_CORE)/*.S)
+
+# $(call fw_board,NAME,MCU,VARIANT,BOARD_DEFINE,EXTRA_DEFINES,SKETCH_SOURCES)
+# Builds $(FW_BUILD)/NAME/NAME.elf/.hex from the Arduino core and the sources.
+define fw_board
+FW_$(1)_DIR := $$(FW_BUILD)/$(1)
+FW_$(1)_FLAGS := -mmcu=$(2) $$(FW_AVR_COMMON) -DARDUINO_$(4) $(5) -I$$(ARDUINO_CORE) -I$$(ARDUINO_AVR)/variants/$(3)
+FW_$(1)_CORE_OBJ := $$(patsubst $$(ARDUINO_CORE)/%,$$(FW_$(1)_DIR)/core/%.o,$$(FW_CORE_C) $$(FW_CORE_CXX) $$(FW_CORE_S))
+
+$$(FW_$(1)_DIR)/core/%.c.o: $$(ARDUINO_CORE)/%.c
+	@mkdir -p $$(@D)
+	$$(AVR_CC) -c -w $$(FW_$(1)_FLAGS) $$(FW_AVR_CFLAGS) $$< -o $$@
+$$(FW_$(1)_DIR)/core/%.cpp.o: $$(ARDUINO_CORE)/%.cpp
+	@mkdir -p $$(@D)
+	$$(AVR_CXX) -c -w $$(FW_$(1)_FLAGS) $$(FW_AVR_CXXFLAGS) $$< -o $$@
+$$(FW_$(1)_DIR)/core/%.S.o: $$(ARDUINO_CORE)/%.S
+	@mkdir -p $$(@D)
+	$$(AVR_CC) -c -x assembler-with-cpp $$(FW_$(1)_FLAGS) $$< -o $$@
+$$(FW_$(1)_DIR)/core.a: $$(FW_$(1)_CORE_OBJ)
+	@rm -f $$@
+	avr-gcc-ar rcs $$@ $$^
+
+# The sketch and the generated library are compiled in one command with
+# -Werror: they are small, and this keeps the rule independent of how many
+# .cpp files the generator emits.
+$$(FW_$(1)_DIR)/$(1).elf: $(6) $$(FW_HEADERS) $$(FW_PROTO_SRC) $$(FW_PROTO_HDR) $$(FW_$(1)_DIR)/core.a
+	@mkdir -p $$(@D)
+	@test -f $$(DRONE_PROTOCOL_DIR)/src/DroneProtocol.h || { echo "missing $$(DRONE_PROTOCOL_DIR)/src/DroneProtocol.h: run the generator first" >&2; exit 1; }
+	$$(AVR_CXX) $$(FW_$(1)_FLAGS) $$(FW_AVR_CXXFLAGS) $$(FW_WARN) -fuse-linker-plugin -Wl,--gc-sections \
+	  -I$$(DRONE_PROTOCOL_DIR)/src -I$$(FW_DIR)/drone \
+	  -x c++ -include Arduino.h $$(filter %.ino,$(6)) -x none $$(filter-out %.ino,$(6)) $$(FW_PROTO_SRC) \
+	  $$(FW_$(1)_DIR)/core.a -lm -o $$@
+$$(FW_$(1)_DIR)/$(1).hex: $$(FW_$(1)_DIR)/$(1).elf
+	$$(AVR_OBJCOPY) -O ihex -R .eeprom $$< $$@
+endef
+
+FW_DRONE_SRC := $(FW_DIR)/drone/drone.ino $(FW_SKETCH_SRC)
+$(eval $(call fw_board,uno,atmega328p,standard,AVR_UNO,,$(FW_DRONE_SRC)))
+$(eval $(call fw_board,mega,atmega2560,mega,AVR_MEGA2560,,$(FW_DRONE_SRC)))
+$(eval $(call fw_board,uno_ppm,atmega328p,standard,AVR_UNO,-DDRONE_PPM,$(FW_DRONE_SRC)))
+
+FW_ELVES := $(FW_BUILD)/uno/uno.elf $(FW_BUILD)/mega/mega.elf $(FW_BUILD)/uno_ppm/uno_ppm.elf
+FW_HEXES := $(FW_ELVES:.elf=.hex)
+
+.PHONY: firmware firmware-uno firmware-host firmware-sim firmware-clean bench-firmware
+firmware: $(FW_HEXES) firmware-host firmware-sim
+	@$(AVR_SIZE) -C --mcu=atmega328p $(FW_BUILD)/uno/uno.elf | grep -E 'Program|Data' | sed 's/^/uno:      /'
+	@$(AVR_SIZE) -C --mcu=atmega328p $(FW_BUILD)/uno_ppm/uno_ppm.elf | grep -E 'Program|Data' | sed 's/^/uno ppm:  /'
+	@$(AVR_SIZE) -C --mcu=atmega2560 $(FW_BUILD)/mega/mega.elf | grep -E 'Program|Data' | sed 's/^/mega:     /'
+
+firmware-uno: $(FW_BUILD)/uno/uno.hex
+
+# --- host build ---------------------------------------------------------------
+FW_HOST_DIR := $(FW_BUILD)/host
+FW_HOST_FLAGS := -std=c++11 -O1 -g $(FW_WARN) -I$(FW_DIR)/host -I$(FW_DIR)/drone -I$(DRONE_PROTOCOL_DIR)/src
+FW_HOST_LOGIC := $(FW_DIR)/drone/drone_app.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_DIR)/drone/pulse_schedule.cpp \
+                 $(FW_DIR)/host/pulse_out_host.cpp $(FW_DIR)/host/fake_arduino.cpp
+FW_HOST_DEPS = $(FW_HEADERS) $(wildcard $(FW_DIR)/host/*.h) $(FW_PROTO_SRC) $(FW_PROTO_HDR)
+
+$(FW_HOST_DIR)/virtual_drone: $(FW_DIR)/host/virtual_drone.cpp $(FW_HOST_LOGIC) $(FW_HOST_DEPS)
+	@mkdir -p $(@D)
+	$(HOST_CXX) $(FW_HOST_FLAGS) $(filter %.cpp,$^) $(FW_PROTO_SRC) -o $@
+
+$(FW_HOST_DIR)/pulse_schedule_test: $(FW_DIR)/host/pulse_schedule_test.cpp $(FW_DIR)/drone/pulse_schedule.cpp $(FW_HEADERS)
+	@mkdir -p $(@D)
+	$(HOST_CXX) $(FW_HOST_FLAGS) $(filter %.cpp,$^) -o $@
+
+firmware-host: $(FW_HOST_DIR)/virtual_drone $(FW_HOST_DIR)/pulse_schedule_test
+
+# --- simavr harness -----------------------------------------------------------
+$(FW_BUILD)/sim/drone_sim: $(FW_DIR)/sim/drone_sim.c
+	@mkdir -p $(@D)
+	$(HOST_CC) -std=gnu11 -O2 -Wall -Wextra -Werror $< $$(pkg-config --cflags --libs simavr) -o $@
+
+firmware-sim: $(FW_BUILD)/sim/drone_sim
+
+firmware-clean:
+	rm -rf $(FW_BUILD)
+
+-include bench/firmware/bench.mk

@@ -1,0 +1,30 @@
+// Test-side controls of the fake Arduino core.
+#ifndef FAKE_ARDUINO_CONTROL_H
+#define FAKE_ARDUINO_CONTROL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include <string>
+
+namespace fake {
+
+// Same sizes as the AVR core's HardwareSerial, so overflow behaves alike.
+constexpr size_t RX_BUFFER = 64;
+constexpr size_t TX_BUFFER = 64;
+
+void set_millis(uint32_t ms);
+uint32_t now();
+// Queues received bytes as the UART would; bytes beyond the buffer are lost
+// (returns how many were taken).
+size_t rx_push(const uint8_t* data, size_t length);
+size_t rx_space();
+// Takes everything the firmware wrote since the last call (empties the TX
+// buffer as the UART would by sending it).
+std::string tx_take();
+uint32_t serial_baud();
+int pin(uint8_t pin);
+
+}  // namespace fake
+
+#endif

@@ -1,0 +1,255 @@
+// Virtual drone: the firmware logic against the fake Arduino core, talking
+// over a pseudo-terminal (or stdin), reporting its outputs as JSON lines.
+//
+//   virtual_drone [--clock realtime|stepped] [--stdin] [--duration MS]
+//
+// pty mode (default): prints {"pty": "/dev/pts/N"} first; the Pi side opens
+//   that path. Replies go back over the pty.
+// --clock stepped: stdin carries "step <ms>" lines; each one reads the bytes
+//   waiting on the pty, runs the loop 1 ms at a time, prints the change lines
+//   and then {"tick": t_ms}. Nothing depends on the wall clock.
+// --stdin: serial input from stdin instead of a pty, replies printed as
+//   {"t_ms":..,"tx":"..."}. With --clock stepped, stdin is a script of lines
+//   "rx <hex bytes>" and "step <ms>" (used by the tests).
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <deque>
+#include <string>
+
+#include "../drone/drone_app.h"
+#include "fake_arduino.h"
+
+namespace {
+
+enum class Clock { Realtime, Stepped };
+
+struct Options {
+  Clock clock = Clock::Realtime;
+  bool use_stdin = false;
+  long duration_ms = -1;
+};
+
+int g_master = -1;
+std::deque<uint8_t> g_pending;  // bytes "on the wire", not yet in the UART
+uint32_t g_byte_credit = 0;     // in 1/10000 byte units
+uint32_t g_t = 0;
+bool g_first = true;
+drone::Outputs g_last;
+drone::State g_last_state;
+bool g_last_armed = false;
+Options g_opt;
+
+void json_string(std::string& out, const std::string& s) {
+  out += '"';
+  for (unsigned char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += static_cast<char>(c);
+    } else if (c == '\n') {
+      out += "\\n";
+    } else if (c < 0x20 || c >= 0x7f) {
+      char buf[8];
+      snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  out += '"';
+}
+
+void report_if_changed() {
+  const drone::Drone& d = drone_app::logic();
+  const drone::Outputs& o = d.outputs();
+  if (!g_first && o == g_last && d.state() == g_last_state && d.armed() == g_last_armed) return;
+  g_first = false;
+  g_last = o;
+  g_last_state = d.state();
+  g_last_armed = d.armed();
+  printf(
+      "{\"t_ms\":%u,\"roll\":%u,\"pitch\":%u,\"throttle\":%u,\"yaw\":%u,\"mode\":%u,\"pan\":%u,\"tilt\":%u,"
+      "\"laser\":%s,\"armed\":%s,\"state\":\"%s\"}\n",
+      g_t, o.roll, o.pitch, o.throttle, o.yaw, o.mode, o.pan, o.tilt, o.laser ? "true" : "false",
+      d.armed() ? "true" : "false", drone::state_name(d.state()));
+}
+
+void send_replies() {
+  const std::string tx = fake::tx_take();
+  if (tx.empty()) return;
+  if (g_opt.use_stdin) {
+    std::string line = "{\"t_ms\":" + std::to_string(g_t) + ",\"tx\":";
+    json_string(line, tx);
+    line += "}\n";
+    fputs(line.c_str(), stdout);
+  } else if (g_master >= 0) {
+    // Non-blocking: with nobody reading, replies are lost, as on a real UART.
+    ssize_t r = write(g_master, tx.data(), tx.size());
+    (void)r;
+  }
+}
+
+// One millisecond of firmware time: the wire delivers what 1 ms of the baud
+// rate carries, then the sketch's loop() runs.
+void run_one_ms() {
+  ++g_t;
+  fake::set_millis(g_t);
+  g_byte_credit += drone::dp::BAUD;  // bytes/ms = BAUD / 10 bits / 1000
+  while (!g_pending.empty() && g_byte_credit >= 10000 && fake::rx_space() > 0) {
+    const uint8_t b = g_pending.front();
+    g_pending.pop_front();
+    fake::rx_push(&b, 1);
+    g_byte_credit -= 10000;
+  }
+  if (g_pending.empty() && g_byte_credit > 20000) g_byte_credit = 20000;
+  drone_app::loop();
+  send_replies();
+  report_if_changed();
+}
+
+void read_master() {
+  if (g_master < 0) return;
+  uint8_t buf[256];
+  for (;;) {
+    const ssize_t n = read(g_master, buf, sizeof buf);
+    if (n <= 0) break;  // EAGAIN, or EIO while no client has the port open
+    g_pending.insert(g_pending.end(), buf, buf + n);
+  }
+}
+
+int open_pty() {
+  const int m = posix_openpt(O_RDWR | O_NOCTTY);
+  if (m < 0 || grantpt(m) != 0 || unlockpt(m) != 0) {
+    perror("pty");
+    exit(1);
+  }
+  const char* name = ptsname(m);
+  // Keep a slave descriptor open ourselves: the master then never sees a
+  // hang-up between clients, and the port is raw from the start (no echo).
+  const int s = open(name, O_RDWR | O_NOCTTY);
+  if (s >= 0) {
+    termios tio;
+    tcgetattr(s, &tio);
+    cfmakeraw(&tio);
+    tcsetattr(s, TCSANOW, &tio);
+  }
+  fcntl(m, F_SETFL, fcntl(m, F_GETFL) | O_NONBLOCK);
+  printf("{\"pty\": \"%s\"}\n", name);
+  fflush(stdout);
+  return m;
+}
+
+uint64_t wall_ms() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<uint64_t>(ts.tv_sec) * 1000u + static_cast<uint64_t>(ts.tv_nsec) / 1000000u;
+}
+
+bool parse_hex(const char* s, std::deque<uint8_t>& out) {
+  while (*s == ' ') ++s;
+  while (s[0] && s[0] != '\n') {
+    char hex[3] = {s[0], s[1], 0};
+    char* end = nullptr;
+    const long v = strtol(hex, &end, 16);
+    if (end != hex + 2) return false;
+    out.push_back(static_cast<uint8_t>(v));
+    s += 2;
+  }
+  return true;
+}
+
+int run_stepped() {
+  char line[4096];
+  while (fgets(line, sizeof line, stdin)) {
+    if (strncmp(line, "step", 4) == 0) {
+      const long ms = strtol(line + 4, nullptr, 10);
+      read_master();
+      for (long i = 0; i < ms; ++i) run_one_ms();
+      printf("{\"tick\":%u}\n", g_t);
+      fflush(stdout);
+    } else if (g_opt.use_stdin && strncmp(line, "rx", 2) == 0) {
+      if (!parse_hex(line + 2, g_pending)) {
+        fprintf(stderr, "bad hex: %s", line);
+        return 2;
+      }
+    } else if (strncmp(line, "quit", 4) == 0) {
+      break;
+    } else if (line[0] != '\n' && line[0] != '#') {
+      fprintf(stderr, "unknown command: %s", line);
+      return 2;
+    }
+  }
+  return 0;
+}
+
+int run_realtime() {
+  const uint64_t start = wall_ms();
+  bool stdin_open = g_opt.use_stdin;
+  for (;;) {
+    pollfd fds[1];
+    fds[0].fd = g_opt.use_stdin ? (stdin_open ? 0 : -1) : g_master;
+    fds[0].events = POLLIN;
+    poll(fds, 1, 1);
+    if (g_opt.use_stdin && stdin_open && (fds[0].revents & (POLLIN | POLLHUP))) {
+      uint8_t buf[256];
+      const ssize_t n = read(0, buf, sizeof buf);
+      if (n <= 0) {
+        stdin_open = false;
+      } else {
+        g_pending.insert(g_pending.end(), buf, buf + n);
+      }
+    } else if (!g_opt.use_stdin) {
+      read_master();
+    }
+    const uint64_t now = wall_ms() - start;
+    while (g_t < now) run_one_ms();
+    fflush(stdout);
+    if (g_opt.duration_ms >= 0 && g_t >= g_opt.duration_ms) break;
+    // --stdin without a duration: stop once the input is used up.
+    if (g_opt.use_stdin && !stdin_open && g_opt.duration_ms < 0 && g_pending.empty()) break;
+  }
+  return 0;
+}
+
+void usage() {
+  fputs("usage: virtual_drone [--clock realtime|stepped] [--stdin] [--duration MS]\n", stderr);
+  exit(2);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--clock" && i + 1 < argc) {
+      const std::string c = argv[++i];
+      if (c == "realtime") {
+        g_opt.clock = Clock::Realtime;
+      } else if (c == "stepped") {
+        g_opt.clock = Clock::Stepped;
+      } else {
+        usage();
+      }
+    } else if (a == "--stdin") {
+      g_opt.use_stdin = true;
+    } else if (a == "--duration" && i + 1 < argc) {
+      g_opt.duration_ms = strtol(argv[++i], nullptr, 10);
+    } else {
+      usage();
+    }
+  }
+  setvbuf(stdout, nullptr, _IOLBF, 0);
+  if (!g_opt.use_stdin) g_master = open_pty();
+  fake::set_millis(0);
+  drone_app::setup();
+  send_replies();
+  report_if_changed();
+  return g_opt.clock == Clock::Stepped ? run_stepped() : run_realtime();
+}

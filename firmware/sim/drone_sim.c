@@ -1,0 +1,253 @@
+/*
+ * simavr test bench for the drone firmware: runs the real .elf, injects UART
+ * bytes at given simulated times, and reports what the pins and the UART did,
+ * timed by the simulated cycle counter (deterministic, no wall clock).
+ *
+ *   drone_sim --elf FILE [--mcu atmega328p|atmega2560] --until MS [--script FILE]
+ *
+ * Script (file or stdin): one event per line, "<ms> <hex bytes>": the bytes
+ * are queued for the UART at that simulated time and go in back to back at
+ * the line's baud rate (the UART model paces them).
+ *
+ * Output, one JSON object per line (times in CPU cycles, 16 per microsecond):
+ *   {"ev":"pulse","pin":P,"rise":C,"width":C}   a high pulse on Arduino pin P
+ *   {"ev":"level","pin":P,"t":C,"v":0|1}         every level change (laser pin only)
+ *   {"ev":"tx","t":C,"text":"..."}                a line the firmware sent
+ *   {"ev":"end","t":C,"unsent":N}                 N = script bytes never taken
+ */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "avr_ioport.h"
+#include "avr_uart.h"
+#include "sim_avr.h"
+#include "sim_elf.h"
+#include "sim_irq.h"
+
+typedef struct {
+  int pin;
+  char port;
+  int bit;
+} pin_map_t;
+
+/* Arduino pin -> AVR port bit, for the pins the firmware drives (7 is the
+ * bench marker pin). */
+static const pin_map_t uno_pins[] = {{2, 'D', 2}, {3, 'D', 3}, {4, 'D', 4}, {5, 'D', 5}, {6, 'D', 6},
+                                     {7, 'D', 7}, {9, 'B', 1}, {10, 'B', 2}, {13, 'B', 5}};
+static const pin_map_t mega_pins[] = {{2, 'E', 4}, {3, 'E', 5}, {4, 'G', 5}, {5, 'E', 3}, {6, 'H', 3},
+                                      {7, 'H', 4}, {9, 'H', 6}, {10, 'B', 4}, {13, 'B', 7}};
+#define PIN_COUNT 9
+#define LASER_PIN 13
+
+typedef struct {
+  int pin;
+  int level;
+  int rose; /* a real rising edge was seen (the first event may be pinMode) */
+  avr_cycle_count_t rise;
+} watch_t;
+
+typedef struct {
+  avr_cycle_count_t when;
+  uint8_t *bytes;
+  size_t length;
+} event_t;
+
+static avr_t *avr;
+static watch_t watches[PIN_COUNT];
+static avr_irq_t *uart_in;
+static int uart_xon;
+static uint8_t *pending;
+static size_t pending_head, pending_tail, pending_cap;
+static event_t *events;
+static size_t event_count, event_next;
+static char tx_line[256];
+static size_t tx_len;
+
+static void no_sleep(avr_t *a, avr_cycle_count_t howLong) {
+  (void)a;
+  (void)howLong;
+}
+
+static void pin_changed(struct avr_irq_t *irq, uint32_t value, void *param) {
+  (void)irq;
+  watch_t *w = param;
+  const int v = value ? 1 : 0;
+  if (v == w->level) return;
+  w->level = v;
+  if (w->pin == LASER_PIN) printf("{\"ev\":\"level\",\"pin\":%d,\"t\":%llu,\"v\":%d}\n", w->pin, (unsigned long long)avr->cycle, v);
+  if (v) {
+    w->rise = avr->cycle;
+    w->rose = 1;
+  } else if (w->rose) {
+    printf("{\"ev\":\"pulse\",\"pin\":%d,\"rise\":%llu,\"width\":%llu}\n", w->pin, (unsigned long long)w->rise,
+           (unsigned long long)(avr->cycle - w->rise));
+  }
+}
+
+static void flush_pending(void) {
+  while (uart_xon && pending_head < pending_tail) avr_raise_irq(uart_in, pending[pending_head++]);
+}
+
+static void uart_xon_hook(struct avr_irq_t *irq, uint32_t value, void *param) {
+  (void)irq;
+  (void)value;
+  (void)param;
+  uart_xon = 1;
+  flush_pending();
+}
+
+static void uart_xoff_hook(struct avr_irq_t *irq, uint32_t value, void *param) {
+  (void)irq;
+  (void)value;
+  (void)param;
+  uart_xon = 0;
+}
+
+static void uart_out_hook(struct avr_irq_t *irq, uint32_t value, void *param) {
+  (void)irq;
+  (void)param;
+  if (tx_len < sizeof tx_line - 1) tx_line[tx_len++] = (char)value;
+  if (value != '\n' && tx_len < sizeof tx_line - 1) return;
+  printf("{\"ev\":\"tx\",\"t\":%llu,\"text\":\"", (unsigned long long)avr->cycle);
+  for (size_t i = 0; i < tx_len; ++i) {
+    const unsigned char c = (unsigned char)tx_line[i];
+    if (c == '"' || c == '\\') printf("\\%c", c);
+    else if (c == '\n') printf("\\n");
+    else if (c < 0x20 || c >= 0x7f) printf("\\u%04x", c);
+    else putchar(c);
+  }
+  printf("\"}\n");
+  tx_len = 0;
+}
+
+static avr_cycle_count_t inject(struct avr_t *a, avr_cycle_count_t when, void *param) {
+  (void)a;
+  (void)when;
+  (void)param;
+  while (event_next < event_count && events[event_next].when <= avr->cycle) {
+    const event_t *e = &events[event_next++];
+    if (pending_tail + e->length > pending_cap) {
+      pending_cap = (pending_tail + e->length) * 2;
+      pending = realloc(pending, pending_cap);
+    }
+    memcpy(pending + pending_tail, e->bytes, e->length);
+    pending_tail += e->length;
+  }
+  flush_pending();
+  /* Re-arm for the next scripted event (0 = done). */
+  return event_next < event_count ? events[event_next].when : 0;
+}
+
+static int by_time(const void *a, const void *b) {
+  const event_t *x = a, *y = b;
+  return x->when < y->when ? -1 : x->when > y->when;
+}
+
+static void read_script(FILE *f) {
+  char line[8192];
+  size_t cap = 0;
+  while (fgets(line, sizeof line, f)) {
+    char *p = line;
+    while (*p == ' ') ++p;
+    if (*p == '#' || *p == '\n' || *p == 0) continue;
+    char *end;
+    const double ms = strtod(p, &end);
+    if (end == p) {
+      fprintf(stderr, "bad script line: %s", line);
+      exit(2);
+    }
+    p = end;
+    while (*p == ' ') ++p;
+    if (event_count == cap) {
+      cap = cap ? cap * 2 : 64;
+      events = realloc(events, cap * sizeof *events);
+    }
+    event_t *e = &events[event_count++];
+    e->when = (avr_cycle_count_t)(ms * 16000.0 + 0.5);
+    e->bytes = malloc(strlen(p) / 2 + 1);
+    e->length = 0;
+    while (p[0] && p[0] != '\n' && p[0] != '\r') {
+      unsigned int v;
+      if (sscanf(p, "%2x", &v) != 1 || !p[1]) {
+        fprintf(stderr, "bad hex in script: %s", line);
+        exit(2);
+      }
+      e->bytes[e->length++] = (uint8_t)v;
+      p += 2;
+    }
+  }
+  qsort(events, event_count, sizeof *events, by_time);
+}
+
+int main(int argc, char **argv) {
+  const char *elf = NULL, *mcu = "atmega328p", *script = NULL;
+  double until_ms = -1;
+  for (int i = 1; i < argc; ++i) {
+    if (!strcmp(argv[i], "--elf") && i + 1 < argc) elf = argv[++i];
+    else if (!strcmp(argv[i], "--mcu") && i + 1 < argc) mcu = argv[++i];
+    else if (!strcmp(argv[i], "--until") && i + 1 < argc) until_ms = atof(argv[++i]);
+    else if (!strcmp(argv[i], "--script") && i + 1 < argc) script = argv[++i];
+    else {
+      fprintf(stderr, "usage: drone_sim --elf FILE [--mcu atmega328p|atmega2560] --until MS [--script FILE]\n");
+      return 2;
+    }
+  }
+  if (!elf || until_ms < 0) {
+    fprintf(stderr, "--elf and --until are required\n");
+    return 2;
+  }
+  FILE *sf = script ? fopen(script, "r") : stdin;
+  if (!sf) {
+    perror(script);
+    return 2;
+  }
+  read_script(sf);
+
+  static char outbuf[1 << 16];
+  setvbuf(stdout, outbuf, _IOFBF, sizeof outbuf);
+
+  elf_firmware_t fw;
+  memset(&fw, 0, sizeof fw);
+  if (elf_read_firmware(elf, &fw) != 0) {
+    fprintf(stderr, "cannot read %s\n", elf);
+    return 1;
+  }
+  avr = avr_make_mcu_by_name(mcu);
+  if (!avr) {
+    fprintf(stderr, "unknown mcu %s\n", mcu);
+    return 1;
+  }
+  avr_init(avr);
+  avr_load_firmware(avr, &fw);
+  avr->frequency = 16000000; /* a plain ELF carries no clock */
+  avr->sleep = no_sleep;     /* run flat out, never usleep() */
+
+  uint32_t flags = 0;
+  avr_ioctl(avr, AVR_IOCTL_UART_GET_FLAGS('0'), &flags);
+  flags &= ~(AVR_UART_FLAG_STDIO | AVR_UART_FLAG_POLL_SLEEP);
+  avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
+  uart_in = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
+  avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT), uart_out_hook, NULL);
+  avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XON), uart_xon_hook, NULL);
+  avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XOFF), uart_xoff_hook, NULL);
+
+  const pin_map_t *map = strcmp(mcu, "atmega2560") == 0 ? mega_pins : uno_pins;
+  for (int i = 0; i < PIN_COUNT; ++i) {
+    watches[i].pin = map[i].pin;
+    avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(map[i].port), map[i].bit), pin_changed,
+                            &watches[i]);
+  }
+  if (event_count) avr_cycle_timer_register(avr, events[0].when > avr->cycle ? events[0].when - avr->cycle : 1, inject, NULL);
+
+  const avr_cycle_count_t end = (avr_cycle_count_t)(until_ms * 16000.0);
+  int state = cpu_Running;
+  while (avr->cycle < end && state != cpu_Done && state != cpu_Crashed) state = avr_run(avr);
+  size_t unsent = pending_tail - pending_head;
+  for (size_t i = event_next; i < event_count; ++i) unsent += events[i].length;
+  printf("{\"ev\":\"end\",\"t\":%llu,\"unsent\":%zu,\"state\":%d}\n", (unsigned long long)avr->cycle, unsent,
+         state);
+  fflush(stdout);
+  return state == cpu_Crashed ? 1 : 0;
+}
