@@ -48,16 +48,17 @@ FW_$(1)_CORE_OBJ := $$(patsubst $$(ARDUINO_CORE)/%,$$(FW_$(1)_DIR)/core/%.o,$$(F
 
 $$(FW_$(1)_DIR)/core/%.c.o: $$(ARDUINO_CORE)/%.c
 	@mkdir -p $$(@D)
-	$$(AVR_CC) -c -w $$(FW_$(1)_FLAGS) $$(FW_AVR_CFLAGS) $$< -o $$@
+	@$$(AVR_CC) -c -w $$(FW_$(1)_FLAGS) $$(FW_AVR_CFLAGS) $$< -o $$@
 $$(FW_$(1)_DIR)/core/%.cpp.o: $$(ARDUINO_CORE)/%.cpp
 	@mkdir -p $$(@D)
-	$$(AVR_CXX) -c -w $$(FW_$(1)_FLAGS) $$(FW_AVR_CXXFLAGS) $$< -o $$@
+	@$$(AVR_CXX) -c -w $$(FW_$(1)_FLAGS) $$(FW_AVR_CXXFLAGS) $$< -o $$@
 $$(FW_$(1)_DIR)/core/%.S.o: $$(ARDUINO_CORE)/%.S
 	@mkdir -p $$(@D)
-	$$(AVR_CC) -c -x assembler-with-cpp $$(FW_$(1)_FLAGS) $$< -o $$@
+	@$$(AVR_CC) -c -x assembler-with-cpp $$(FW_$(1)_FLAGS) $$< -o $$@
 $$(FW_$(1)_DIR)/core.a: $$(FW_$(1)_CORE_OBJ)
 	@rm -f $$@
-	avr-gcc-ar rcs $$@ $$^
+	@echo "  AR    $$@ (Arduino core)"
+	@avr-gcc-ar rcs $$@ $$^
 
 # The sketch and the generated library are compiled in one command with
 # -Werror: they are small, and this keeps the rule independent of how many
@@ -65,12 +66,13 @@ $$(FW_$(1)_DIR)/core.a: $$(FW_$(1)_CORE_OBJ)
 $$(FW_$(1)_DIR)/$(1).elf: $(6) $$(FW_HEADERS) $$(FW_PROTO_SRC) $$(FW_PROTO_HDR) $$(FW_$(1)_DIR)/core.a
 	@mkdir -p $$(@D)
 	@test -f $$(DRONE_PROTOCOL_DIR)/src/DroneProtocol.h || { echo "missing $$(DRONE_PROTOCOL_DIR)/src/DroneProtocol.h: run the generator first" >&2; exit 1; }
-	$$(AVR_CXX) $$(FW_$(1)_FLAGS) $$(FW_AVR_CXXFLAGS) $$(FW_WARN) -fuse-linker-plugin -Wl,--gc-sections \
+	@echo "  LD    $$@"
+	@$$(AVR_CXX) $$(FW_$(1)_FLAGS) $$(FW_AVR_CXXFLAGS) $$(FW_WARN) -fuse-linker-plugin -Wl,--gc-sections \
 	  -I$$(DRONE_PROTOCOL_DIR)/src -I$$(FW_DIR)/drone \
 	  -x c++ -include Arduino.h $$(filter %.ino,$(6)) -x none $$(filter-out %.ino,$(6)) $$(FW_PROTO_SRC) \
 	  $$(FW_$(1)_DIR)/core.a -lm -o $$@
 $$(FW_$(1)_DIR)/$(1).hex: $$(FW_$(1)_DIR)/$(1).elf
-	$$(AVR_OBJCOPY) -O ihex -R .eeprom $$< $$@
+	@$$(AVR_OBJCOPY) -O ihex -R .eeprom $$< $$@
 endef
 
 FW_DRONE_SRC := $(FW_DIR)/drone/drone.ino $(FW_SKETCH_SRC)
@@ -98,18 +100,21 @@ FW_HOST_DEPS = $(FW_HEADERS) $(wildcard $(FW_DIR)/host/*.h) $(FW_PROTO_SRC) $(FW
 
 $(FW_HOST_DIR)/virtual_drone: $(FW_DIR)/host/virtual_drone.cpp $(FW_HOST_LOGIC) $(FW_HOST_DEPS)
 	@mkdir -p $(@D)
-	$(HOST_CXX) $(FW_HOST_FLAGS) $(filter %.cpp,$^) $(FW_PROTO_SRC) -o $@
+	@echo "  CXX   $@"
+	@$(HOST_CXX) $(FW_HOST_FLAGS) $(filter %.cpp,$^) $(FW_PROTO_SRC) -o $@
 
 $(FW_HOST_DIR)/pulse_schedule_test: $(FW_DIR)/host/pulse_schedule_test.cpp $(FW_DIR)/drone/pulse_schedule.cpp $(FW_HEADERS)
 	@mkdir -p $(@D)
-	$(HOST_CXX) $(FW_HOST_FLAGS) $(filter %.cpp,$^) -o $@
+	@echo "  CXX   $@"
+	@$(HOST_CXX) $(FW_HOST_FLAGS) $(filter %.cpp,$^) -o $@
 
 firmware-host: $(FW_HOST_DIR)/virtual_drone $(FW_HOST_DIR)/pulse_schedule_test
 
 # --- simavr harness -----------------------------------------------------------
 $(FW_BUILD)/sim/drone_sim: $(FW_DIR)/sim/drone_sim.c
 	@mkdir -p $(@D)
-	$(HOST_CC) -std=gnu11 -O2 -Wall -Wextra -Werror $< $$(pkg-config --cflags --libs simavr) -o $@
+	@echo "  CC    $@"
+	@$(HOST_CC) -std=gnu11 -O2 -Wall -Wextra -Werror $< $$(pkg-config --cflags --libs simavr) -o $@
 
 firmware-sim: $(FW_BUILD)/sim/drone_sim
 

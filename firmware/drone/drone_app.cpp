@@ -24,8 +24,8 @@ bool laser_written = false;
 uint16_t servo_us(uint8_t deg) {
   using namespace pulse_timing;
   return static_cast<uint16_t>(SERVO_MIN_US + (static_cast<uint32_t>(deg) * (SERVO_MAX_US - SERVO_MIN_US) +
-                                               drone::dp::SERVO_MAX_DEG / 2) /
-                                                  drone::dp::SERVO_MAX_DEG);
+                                               SERVO_FULL_SCALE_DEG / 2) /
+                                                  SERVO_FULL_SCALE_DEG);
 }
 
 void widths_of(const drone::Outputs& o, uint16_t w[pulse::OUTPUTS]) {

@@ -25,7 +25,11 @@ uint16_t clamp16(int32_t v, uint16_t lo, uint16_t hi) {
   return v < lo ? lo : (v > hi ? hi : static_cast<uint16_t>(v));
 }
 
-const dp::ChannelLimits& limits(dp::Target t) { return dp::channel_limits(t); }
+dp::ChannelLimits limits(dp::Target t) { return dp::channel_limits(t); }
+
+uint8_t servo_default(dp::Target t) { return t == dp::Target::Pan ? dp::SERVO_PAN_DEFAULT : dp::SERVO_TILT_DEFAULT; }
+uint8_t servo_min(dp::Target t) { return t == dp::Target::Pan ? dp::SERVO_PAN_MIN : dp::SERVO_TILT_MIN; }
+uint8_t servo_max(dp::Target t) { return t == dp::Target::Pan ? dp::SERVO_PAN_MAX : dp::SERVO_TILT_MAX; }
 
 }  // namespace
 
@@ -68,8 +72,8 @@ void Drone::begin(uint32_t now_ms) {
   parser_.reset();
   armed_ = false;
   out_.mode = dp::MODE_STABILIZE_US;
-  out_.pan = dp::SERVO_PAN_DEFAULT_DEG;
-  out_.tilt = dp::SERVO_TILT_DEFAULT_DEG;
+  out_.pan = dp::SERVO_PAN_DEFAULT;
+  out_.tilt = dp::SERVO_TILT_DEFAULT;
   out_.laser = false;
   enter(State::Disarmed);
   char line[32];
@@ -111,7 +115,7 @@ bool Drone::sequence_running() const {
 }
 
 void Drone::set_channel(dp::Target t, uint16_t us) {
-  const dp::ChannelLimits& l = limits(t);
+  const dp::ChannelLimits l = limits(t);
   const uint16_t v = clamp16(us, l.min, l.max);  // Table 4 extremes, whatever asked
   switch (t) {
     case dp::Target::Roll: out_.roll = v; break;
@@ -184,14 +188,12 @@ void Drone::self_test_step(uint8_t step) {
       break;
     case dp::Target::Pan:
     case dp::Target::Tilt: {
-      const uint8_t deg = s.level < 0 ? dp::SERVO_MIN_DEG
-                          : s.level > 0 ? dp::SERVO_MAX_DEG
-                          : (s.target == dp::Target::Pan ? dp::SERVO_PAN_DEFAULT_DEG : dp::SERVO_TILT_DEFAULT_DEG);
+      const uint8_t deg = s.level < 0 ? servo_min(s.target) : s.level > 0 ? servo_max(s.target) : servo_default(s.target);
       (s.target == dp::Target::Pan ? out_.pan : out_.tilt) = deg;
       break;
     }
     default: {
-      const dp::ChannelLimits& l = limits(s.target);
+      const dp::ChannelLimits l = limits(s.target);
       set_channel(s.target, s.level < 0 ? l.low : s.level > 0 ? l.high : l.median);
       break;
     }
@@ -205,8 +207,8 @@ void Drone::update(uint32_t now_ms) {
     // Link lost: this overrides any movement or sequence in progress.
     if (state_ == State::Arming) armed_ = false;
     if (state_ == State::SelfTest) {
-      out_.pan = dp::SERVO_PAN_DEFAULT_DEG;
-      out_.tilt = dp::SERVO_TILT_DEFAULT_DEG;
+      out_.pan = dp::SERVO_PAN_DEFAULT;
+      out_.tilt = dp::SERVO_TILT_DEFAULT;
     }
     enter(State::Failsafe);
     return;
@@ -268,18 +270,19 @@ void Drone::on_servo(const dp::Command& c) {
     result_ = dp::Error::Busy;
     return;
   }
-  const dp::CommandInfo& info = dp::command_info(c.id);
+  const dp::CommandInfo info = dp::command_info(c.id);
   const int16_t delta = static_cast<int16_t>(info.sense * static_cast<int16_t>(c.value));
   switch (info.target) {
     case dp::Target::Pan:
-      out_.pan = static_cast<uint8_t>(clamp16(out_.pan + delta, dp::SERVO_MIN_DEG, dp::SERVO_MAX_DEG));
+    case dp::Target::Tilt: {
+      // Clamped to the servo's range: "sr0180" from 90 deg stops at the end.
+      uint8_t& angle = info.target == dp::Target::Pan ? out_.pan : out_.tilt;
+      angle = static_cast<uint8_t>(clamp16(angle + delta, servo_min(info.target), servo_max(info.target)));
       break;
-    case dp::Target::Tilt:
-      out_.tilt = static_cast<uint8_t>(clamp16(out_.tilt + delta, dp::SERVO_MIN_DEG, dp::SERVO_MAX_DEG));
-      break;
-    case dp::Target::BothServos:
-      out_.pan = dp::SERVO_PAN_DEFAULT_DEG;
-      out_.tilt = dp::SERVO_TILT_DEFAULT_DEG;
+    }
+    case dp::Target::Both:
+      out_.pan = dp::SERVO_PAN_DEFAULT;
+      out_.tilt = dp::SERVO_TILT_DEFAULT;
       break;
     default:
       result_ = dp::Error::BadDirection;
@@ -312,8 +315,8 @@ void Drone::on_disarm(const dp::Command&) {
   // Always honoured, even mid-sequence: the way to stop anything.
   if (state_ == State::SelfTest) {
     out_.laser = laser_before_test_;
-    out_.pan = dp::SERVO_PAN_DEFAULT_DEG;
-    out_.tilt = dp::SERVO_TILT_DEFAULT_DEG;
+    out_.pan = dp::SERVO_PAN_DEFAULT;
+    out_.tilt = dp::SERVO_TILT_DEFAULT;
   }
   if (state_ == State::Arming) armed_ = false;
   if (state_ != State::Disarming) enter(State::Disarming);

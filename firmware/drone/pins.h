@@ -37,6 +37,7 @@ constexpr uint16_t PPM_SEPARATOR_US = 300;
 // (the Arduino Servo library's defaults, so existing servo setups agree).
 constexpr uint16_t SERVO_MIN_US = 544;
 constexpr uint16_t SERVO_MAX_US = 2400;
+constexpr uint16_t SERVO_FULL_SCALE_DEG = 180;
 
 }  // namespace pulse_timing
 
