@@ -432,7 +432,7 @@ class _Builder:
         name = r.text("name")
         name_ok = self._identifier(r, "name", name)
         description = r.text("description")
-        field_name = r.get("field", str, default_field)
+        field_name = r.get("field", str, default_field, required=False)
         channel_name = r.get("channel", str, required=False)
         servo_name = r.get("servo", str, required=False)
         sense = r.get("sense", int, required=False)
