@@ -24,6 +24,11 @@ def py_string(text: str) -> str:
     return json.dumps(text)
 
 
+def py_bytes(text: str) -> str:
+    """A Python bytes literal of ASCII text."""
+    return repr(text.encode("ascii"))
+
+
 def docstring(text: str) -> str:
     """Text safe inside a triple-quoted docstring (the spec rejects backslashes)."""
     return text.replace('"', '\\"')
@@ -52,6 +57,7 @@ ALL: dict[str, Callable[..., Any]] = {
     "cpp_char": cpp_char,
     "cpp_string": cpp_string,
     "py_string": py_string,
+    "py_bytes": py_bytes,
     "docstring": docstring,
     "md_cell": md_cell,
     "md_code": md_code,

@@ -75,7 +75,8 @@ def render_all(spec: Spec) -> dict[str, bytes]:
             out = rel[: -len(".j2")]
             for placeholder, value in names.items():
                 out = out.replace(placeholder, value)
-            files[f"{target.out_dir}/{out}" if target.out_dir else out] = _with_header(target, text, spec).encode("utf-8")
+            path = f"{target.out_dir}/{out}" if target.out_dir else out
+            files[path] = _with_header(target, text, spec).encode("utf-8")
     return files
 
 
