@@ -1,0 +1,254 @@
+"""The serial link to the drone's Arduino, over any pyserial URL or port.
+
+* ``open()`` opens the port (``serial_for_url``: ``/dev/ttyACM0``, ``loop://``, ``socket://``, a pty)
+  and waits for the firmware's ready line (opening the port resets an Arduino); a ready line whose
+  spec fingerprint differs from ``drone_protocol.SPEC_FINGERPRINT`` raises ``FingerprintMismatch``.
+* ``send(frame)`` writes one frame (from a ``drone_protocol`` function) and flushes it.
+* ``poll()`` reads whatever replies have arrived, parses each line with ``parse_reply`` and logs it;
+  lines are bounded, garbage is logged and dropped.
+* A failed read or write closes the port and reopens it within ``reconnect_s``, waiting for the ready
+  line again. Meanwhile nothing is sent: the firmware's own failsafe keeps the drone safe.
+
+The link is a context manager; ``close()`` is safe to call twice.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from types import TracebackType
+from typing import Any, Self
+
+import drone_protocol as dp
+import serial
+
+from pilot.errors import FingerprintMismatch, LinkError, ReadyTimeout
+
+MAX_LINE = 128
+
+
+@dataclass(frozen=True)
+class LogEntry:
+    t: float
+    kind: str  # "tx", "rx", "rx-garbage", "link"
+    data: str
+
+
+def _open_device(path: str, baud: int) -> Any:
+    """Open a device path without pyserial's input flush on open.
+
+    pyserial discards waiting input when it opens a port. A real Arduino resets on open and prints
+    its ready line afterwards, but a board (or the virtual drone's pseudo-terminal) that was already
+    running may have printed it before: discarding it would make the ready-line wait fail. Nothing is
+    lost by keeping the stale input: ``await_ready`` skips every line before the ready line.
+    """
+    port = serial.Serial(None, baudrate=baud, timeout=0, write_timeout=1.0)
+    port.port = path
+    port._reset_input_buffer = lambda: None  # instance override, for open() only
+    try:
+        port.open()
+    finally:
+        del port._reset_input_buffer
+    return port
+
+
+def keepalive_ms(fraction: float) -> int:
+    """The keep-alive period: a fraction of the firmware's command timeout, so it never lapses."""
+    return max(1, int(dp.COMMAND_TIMEOUT_MS * fraction))
+
+
+class Link:
+    def __init__(
+        self,
+        port: str | Any,
+        baud: int = dp.BAUD,
+        *,
+        ready_timeout_s: float = dp.READY_TIMEOUT_MS / 1000.0,
+        reconnect_s: float = 3.0,
+        wait_ready: bool = True,
+        clock: Callable[[], float] = time.monotonic,
+        sleep: Callable[[float], None] = time.sleep,
+        log: Callable[[LogEntry], None] | None = None,
+    ) -> None:
+        self._url = port if isinstance(port, str) else None
+        self._port: Any = None if isinstance(port, str) else port
+        self.baud = baud
+        self.ready_timeout_s = ready_timeout_s
+        self.reconnect_s = reconnect_s
+        self.wait_ready = wait_ready
+        self._clock = clock
+        self._sleep = sleep
+        self._log = log
+        self._buffer = bytearray()
+        self._closed = False
+        self._opened = False
+        self.sent: list[bytes] = []  # every frame written, in order
+        self.replies: list[dp.Reply] = []
+        self.ready: dp.Reply | None = None
+        self.reconnects = 0
+        self.last_send_t: float | None = None
+        self.last_write_done_t: float | None = None
+
+    @property
+    def name(self) -> str:
+        if self._url is not None:
+            return self._url
+        return str(getattr(self._port, "port", None) or self._port)
+
+    def _note(self, kind: str, data: str) -> None:
+        if self._log is not None:
+            self._log(LogEntry(self._clock(), kind, data))
+
+    # -- opening ----------------------------------------------------------------------------------
+    def _open_port(self) -> None:
+        if self._url is None:
+            if self._port is None:
+                raise LinkError("link: no port to open")
+            return
+        try:
+            if "://" in self._url:
+                self._port = serial.serial_for_url(self._url, baudrate=self.baud, timeout=0, write_timeout=1.0)
+            else:
+                self._port = _open_device(self._url, self.baud)
+        except (serial.SerialException, OSError, ValueError) as exc:
+            raise LinkError(f"link {self._url!r}: cannot open: {exc}") from exc
+
+    def open(self) -> Self:
+        self._closed = False
+        self._open_port()
+        self._opened = True
+        self._note("link", f"opened {self.name}")
+        if self.wait_ready:
+            self.await_ready()
+        return self
+
+    def await_ready(self, timeout_s: float | None = None) -> dp.Reply:
+        """Read lines until the ready line; refuse another spec's fingerprint."""
+        limit = self.ready_timeout_s if timeout_s is None else timeout_s
+        deadline = self._clock() + limit
+        while True:
+            for line in self._read_lines():
+                try:
+                    reply = dp.parse_reply(line)
+                except dp.ProtocolError:
+                    self._note("rx-garbage", line.decode("ascii", "replace"))
+                    continue
+                self._note("rx", line.decode("ascii", "replace").rstrip())
+                if reply.kind is dp.ReplyKind.READY:
+                    if reply.fingerprint != dp.SPEC_FINGERPRINT or reply.protocol != dp.PROTOCOL_NAME:
+                        theirs = f"{reply.protocol} {reply.fingerprint}"
+                        raise FingerprintMismatch(f"{dp.PROTOCOL_NAME} {dp.SPEC_FINGERPRINT}", theirs)
+                    self.ready = reply
+                    return reply
+            if self._clock() >= deadline:
+                raise ReadyTimeout(
+                    f"link {self.name!r}: no ready line ('{dp.ReplyKind.READY.value} {dp.PROTOCOL_NAME} ...') "
+                    f"within {limit:.1f} s; is the drone firmware running on this port?"
+                )
+            self._sleep(0.005)
+
+    # -- I/O ----------------------------------------------------------------------------------------
+    def _read_lines(self) -> list[bytes]:
+        if self._port is None:
+            return []
+        waiting = self._port.in_waiting
+        chunk = self._port.read(waiting or 1) if waiting else b""
+        if not chunk:
+            return []
+        self._buffer.extend(chunk)
+        lines: list[bytes] = []
+        while True:
+            nl = self._buffer.find(b"\n")
+            if nl < 0:
+                break
+            lines.append(bytes(self._buffer[: nl + 1]))
+            del self._buffer[: nl + 1]
+        if len(self._buffer) > MAX_LINE:  # no newline in sight: garbage, drop it
+            self._note("rx-garbage", self._buffer.decode("ascii", "replace"))
+            self._buffer.clear()
+        return lines
+
+    def send(self, frame: bytes) -> bool:
+        """Write one frame. Returns False when the port failed and could not be reopened in time."""
+        if self._closed:
+            raise LinkError(f"link {self.name!r}: send after close")
+        self.last_send_t = self._clock()
+        try:
+            self._port.write(frame)
+            self._port.flush()
+        except (serial.SerialException, OSError) as exc:
+            self._note("link", f"write failed: {exc}")
+            return self._recover() and self.send(frame)
+        self.last_write_done_t = self._clock()
+        self.sent.append(frame)
+        self._note("tx", frame.decode("ascii", "replace"))
+        return True
+
+    def poll(self) -> list[dp.Reply]:
+        """Replies that have arrived since the last poll."""
+        try:
+            lines = self._read_lines()
+        except (serial.SerialException, OSError) as exc:
+            self._note("link", f"read failed: {exc}")
+            self._recover()
+            return []
+        out: list[dp.Reply] = []
+        for line in lines:
+            try:
+                reply = dp.parse_reply(line)
+            except dp.ProtocolError:
+                self._note("rx-garbage", line.decode("ascii", "replace"))
+                continue
+            self._note("rx", line.decode("ascii", "replace").rstrip())
+            out.append(reply)
+        self.replies.extend(out)
+        return out
+
+    def _recover(self) -> bool:
+        """Close and reopen the port within ``reconnect_s``; wait for the ready line again."""
+        if self._url is None:
+            raise LinkError(f"link {self.name!r}: the port failed and this link cannot reopen it")
+        self._close_port()
+        deadline = self._clock() + self.reconnect_s
+        delay = 0.05
+        while self._clock() < deadline:
+            try:
+                self._open_port()
+                if self.wait_ready:
+                    self.await_ready(timeout_s=max(0.1, deadline - self._clock()))
+                self.reconnects += 1
+                self._note("link", f"reopened {self.name} (reconnect {self.reconnects})")
+                return True
+            except FingerprintMismatch:
+                raise
+            except LinkError as exc:
+                self._note("link", f"reopen failed: {exc}")
+                self._close_port()
+                self._sleep(delay)
+                delay = min(0.5, delay * 2)
+        raise LinkError(f"link {self.name!r}: lost and not back within {self.reconnect_s:.1f} s")
+
+    # -- closing ----------------------------------------------------------------------------------
+    def _close_port(self) -> None:
+        port, self._port = self._port, None
+        if port is not None:
+            with contextlib.suppress(serial.SerialException, OSError):
+                port.close()
+        self._buffer.clear()
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        self._close_port()
+        self._note("link", "closed")
+
+    def __enter__(self) -> Self:
+        return self if self._opened else self.open()
+
+    def __exit__(
+        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        self.close()

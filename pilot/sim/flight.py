@@ -1,0 +1,208 @@
+"""One simulated flight, end to end, and many of them in a process pool.
+
+The pilot (controller, detector, link) flies against the real virtual drone: frames go over the
+virtual drone's pseudo-terminal through pyserial, the firmware's clock is stepped one tick at a
+time, and the world follows its RC outputs. The link's ready-line wait uses the world's clock too
+(its "sleep" steps the firmware), so nothing waits in real time.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import multiprocessing
+import time
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from pilot.config import PilotConfig
+from pilot.controller import Controller, State
+from pilot.detect import make_detector
+from pilot.link import Link, LogEntry, keepalive_ms
+from pilot.record import Recorder
+from pilot.runner import Observer, run
+from pilot.sim.camera import CameraModel
+from pilot.sim.room import make_scenario
+from pilot.sim.virtual import VirtualDrone
+from pilot.sim.world import SimWorld
+
+SUCCESS_LIT_MS = 500  # laser on the target, within reach, for at least this long
+
+
+@dataclass(frozen=True)
+class FlightResult:
+    scenario: str
+    seed: int
+    detector: str
+    success: bool  # reached the target and lit it
+    lit_on_target_ms: int
+    lit_elsewhere_ms: int
+    reached: bool
+    min_distance: float
+    wall_hits: int
+    crashes: int
+    fired: bool
+    reason: str
+    final_state: str
+    sim_seconds: float
+    wall_seconds: float
+    frames_sent: int
+    reconnects: int
+    record_dir: str | None = None
+    path_picture: str | None = None
+    video: str | None = None
+    error: str | None = None
+
+    def summary(self) -> str:
+        verdict = "reached and lit" if self.success else "FAILED"
+        return (
+            f"{self.scenario:10s} seed {self.seed:3d} {self.detector:5s} {verdict:15s} "
+            f"lit {self.lit_on_target_ms:5d} ms "
+            f"min dist {self.min_distance:4.2f} m walls {self.wall_hits} crashes {self.crashes} "
+            f"sim {self.sim_seconds:5.1f} s wall {self.wall_seconds:5.2f} s ({self.reason})"
+        )
+
+
+@dataclass(frozen=True)
+class FlightJob:
+    scenario: str
+    seed: int
+    detector: str = "hsv"
+    max_seconds: float = 60.0
+    noise: bool = True
+    width: int = 320
+    height: int = 240
+
+
+def fly(
+    scenario_name: str,
+    seed: int,
+    *,
+    config: PilotConfig | None = None,
+    detector_name: str | None = None,
+    max_seconds: float = 60.0,
+    record_dir: str | Path | None = None,
+    camera: CameraModel | None = None,
+    noise: bool = True,
+    executable: str | Path | None = None,
+    lose_camera_at_s: float | None = None,
+    observers: Sequence[Observer] = (),
+) -> FlightResult:
+    cfg = config or PilotConfig()
+    if detector_name is not None:
+        cfg = dataclasses.replace(cfg, detector=detector_name)
+    scenario = make_scenario(scenario_name, seed, noise=noise)
+    detector = make_detector(cfg)
+    recorder = Recorder(record_dir, fps=cfg.link.rate_hz) if record_dir is not None else None
+    wall0 = time.perf_counter()
+    tick_ms = round(1000.0 / cfg.link.rate_hz)
+    try:
+        with (
+            VirtualDrone(executable) as vd,
+            SimWorld(
+                scenario,
+                vd,
+                camera,
+                tick_ms=tick_ms,
+                aim_point="marker" if cfg.detector == "aruco" else "ball",
+                lose_camera_at_s=lose_camera_at_s,
+            ) as world,
+        ):
+
+            def sim_sleep(seconds: float) -> None:
+                world.advance(max(1, round(seconds * 1000.0)))
+
+            def link_log(entry: LogEntry) -> None:
+                if recorder is not None:
+                    recorder.on_link(entry)
+
+            link = Link(
+                vd.pty,
+                ready_timeout_s=cfg.link.ready_timeout_s,
+                reconnect_s=cfg.link.reconnect_s,
+                clock=world.now,
+                sleep=sim_sleep,
+                log=link_log,
+            )
+            with link:
+                controller = Controller(cfg.controller, clock=world.now)
+                watchers: list[Observer] = list(observers)
+                if recorder is not None:
+                    watchers.append(recorder)
+                result = run(
+                    world.camera(),
+                    detector,
+                    controller,
+                    link,
+                    world,
+                    max_seconds=max_seconds,
+                    keepalive_ms=keepalive_ms(cfg.link.keepalive_fraction),
+                    observers=watchers,
+                )
+            score = world.score
+            state = world.model.state
+            picture = None
+            if recorder is not None:
+                picture = str(recorder.path_png(scenario, score.path))
+                recorder.write(
+                    {
+                        "result": {
+                            "reason": result.reason,
+                            "transitions": [
+                                {"t_ms": t.t_ms, "from": t.old.value, "to": t.new.value, "why": t.reason}
+                                for t in controller.transitions
+                            ],
+                            "lit_on_target_ms": score.lit_on_target_ms,
+                            "wall_hits": state.wall_hits,
+                            "crashes": state.crashes,
+                        }
+                    }
+                )
+            success = score.lit_on_target_ms >= SUCCESS_LIT_MS and score.reached
+            return FlightResult(
+                scenario=scenario_name,
+                seed=seed,
+                detector=cfg.detector,
+                success=success,
+                lit_on_target_ms=score.lit_on_target_ms,
+                lit_elsewhere_ms=score.lit_elsewhere_ms,
+                reached=score.reached,
+                min_distance=score.min_distance,
+                wall_hits=state.wall_hits,
+                crashes=state.crashes,
+                fired=result.fired,
+                reason=result.reason,
+                final_state=result.state.value if isinstance(result.state, State) else str(result.state),
+                sim_seconds=world.now(),
+                wall_seconds=time.perf_counter() - wall0,
+                frames_sent=len(link.sent),
+                reconnects=link.reconnects,
+                record_dir=str(recorder.dir) if recorder is not None else None,
+                path_picture=picture,
+                video=str(recorder.video_path) if recorder is not None else None,
+                error=None if result.error is None else f"{type(result.error).__name__}: {result.error}",
+            )
+    finally:
+        if recorder is not None:
+            recorder.close()
+
+
+def _fly_job(job: FlightJob) -> FlightResult:
+    return fly(
+        job.scenario,
+        job.seed,
+        detector_name=job.detector,
+        max_seconds=job.max_seconds,
+        noise=job.noise,
+        camera=CameraModel(job.width, job.height),
+    )
+
+
+def fly_many(jobs: Iterable[FlightJob], processes: int | None = None) -> list[FlightResult]:
+    """Flights in a process pool (one virtual drone per flight), results in job order."""
+    todo = list(jobs)
+    if processes == 1 or len(todo) <= 1:
+        return [_fly_job(job) for job in todo]
+    ctx = multiprocessing.get_context("fork")
+    with ctx.Pool(processes or None) as pool:
+        return pool.map(_fly_job, todo, chunksize=1)
