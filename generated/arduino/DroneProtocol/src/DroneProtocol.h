@@ -23,15 +23,30 @@
 #ifdef __AVR__
 #include <avr/pgmspace.h>
 #define DRONE_PROTOCOL_FLASH PROGMEM
-#define DRONE_PROTOCOL_READ_BYTE(p) pgm_read_byte(p)
-#define DRONE_PROTOCOL_READ_WORD(p) pgm_read_word(p)
 #else
 #define DRONE_PROTOCOL_FLASH
-#define DRONE_PROTOCOL_READ_BYTE(p) (*(const uint8_t*)(p))
-#define DRONE_PROTOCOL_READ_WORD(p) (*(const uint16_t*)(p))
 #endif
 
 namespace drone_protocol {
+
+namespace detail {
+// Reads of the tables, which live in flash on AVR.
+inline uint8_t read_byte(const uint8_t* p) {
+#ifdef __AVR__
+  return pgm_read_byte(p);
+#else
+  return *p;
+#endif
+}
+inline char read_char(const char* p) { return static_cast<char>(read_byte(reinterpret_cast<const uint8_t*>(p))); }
+inline uint16_t read_word(const uint16_t* p) {
+#ifdef __AVR__
+  return pgm_read_word(p);
+#else
+  return *p;
+#endif
+}
+}  // namespace detail
 
 // The code relies on these sizes (int is 16 bits on AVR, 32 on the host: nothing here uses int for data).
 static_assert(sizeof(uint8_t) == 1, "uint8_t must be one byte");
@@ -188,7 +203,7 @@ DRONE_PROTOCOL_FLASH const char ERROR_CODES[] = "?cdgrsltnb";
 // The code letter of the reply that reports `error`.
 inline char error_code(Error error) {
   const uint8_t i = static_cast<uint8_t>(error);
-  return i < sizeof detail::ERROR_CODES - 1 ? static_cast<char>(DRONE_PROTOCOL_READ_BYTE(&detail::ERROR_CODES[i])) : '?';
+  return i < sizeof detail::ERROR_CODES - 1 ? detail::read_char(&detail::ERROR_CODES[i]) : '?';
 }
 
 struct Command {
@@ -257,7 +272,7 @@ DRONE_PROTOCOL_FLASH const ChannelLimits CHANNELS[CHANNEL_COUNT] = {
 // Linear scans of small flash tables: no switch, which avr-gcc would turn into lookup tables in RAM.
 inline int8_t find_category(uint8_t byte) {
   for (uint8_t i = 0; i < CATEGORY_COUNT; ++i) {
-    if (DRONE_PROTOCOL_READ_BYTE(&CATEGORIES[i].code) == byte) return static_cast<int8_t>(i);
+    if (read_byte(&CATEGORIES[i].code) == byte) return static_cast<int8_t>(i);
   }
   return -1;
 }
@@ -266,10 +281,10 @@ inline int8_t find_category(uint8_t byte) {
 inline int8_t find_command(uint8_t category, uint8_t direction) {
   const int8_t c = find_category(category);
   if (c < 0) return -1;
-  const uint8_t first = DRONE_PROTOCOL_READ_BYTE(&CATEGORIES[c].first);
-  const uint8_t end = static_cast<uint8_t>(first + DRONE_PROTOCOL_READ_BYTE(&CATEGORIES[c].count));
+  const uint8_t first = read_byte(&CATEGORIES[c].first);
+  const uint8_t end = static_cast<uint8_t>(first + read_byte(&CATEGORIES[c].count));
   for (uint8_t i = first; i < end; ++i) {
-    if (DRONE_PROTOCOL_READ_BYTE(&COMMANDS[i].direction) == direction) return static_cast<int8_t>(i);
+    if (read_byte(&COMMANDS[i].direction) == direction) return static_cast<int8_t>(i);
   }
   return -1;
 }
@@ -289,7 +304,7 @@ inline Error finish(const uint8_t* frame, Command& out) {
   uint16_t value = 0;
   for (uint8_t i = 2; i < FRAME_LENGTH; ++i) value = static_cast<uint16_t>(value * 10u + (frame[i] - '0'));
   const CommandInfo* info = &COMMANDS[index];
-  if (value < DRONE_PROTOCOL_READ_WORD(&info->min) || value > DRONE_PROTOCOL_READ_WORD(&info->max)) {
+  if (value < read_word(&info->min) || value > read_word(&info->max)) {
     return Error::OutOfRange;
   }
   out.id = static_cast<CommandId>(index);
@@ -684,7 +699,7 @@ DRONE_PROTOCOL_FLASH const char READY_LINE[] = "#READY drone_protocol 0949e89ab1
 
 inline uint8_t write_ready(char* out) {
   uint8_t n = 0;
-  for (char c; (c = static_cast<char>(DRONE_PROTOCOL_READ_BYTE(&detail::READY_LINE[n]))) != '\0'; ++n) out[n] = c;
+  for (char c; (c = detail::read_char(&detail::READY_LINE[n])) != '\0'; ++n) out[n] = c;
   return n;
 }
 
