@@ -93,7 +93,7 @@ firmware-uno: $(FW_BUILD)/uno/uno.hex
 
 # --- host build ---------------------------------------------------------------
 FW_HOST_DIR := $(FW_BUILD)/host
-FW_HOST_FLAGS := -std=c++11 -O1 -g $(FW_WARN) -I$(FW_DIR)/host -I$(FW_DIR)/drone -I$(DRONE_PROTOCOL_DIR)/src
+FW_HOST_FLAGS := -std=c++11 -O1 -g -fsanitize=address,undefined -fno-sanitize-recover=all $(FW_WARN) -I$(FW_DIR)/host -I$(FW_DIR)/drone -I$(DRONE_PROTOCOL_DIR)/src
 FW_HOST_LOGIC := $(FW_DIR)/drone/drone_app.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_DIR)/drone/pulse_schedule.cpp \
                  $(FW_DIR)/host/pulse_out_host.cpp $(FW_DIR)/host/fake_arduino.cpp
 FW_HOST_DEPS = $(FW_HEADERS) $(wildcard $(FW_DIR)/host/*.h) $(FW_PROTO_SRC) $(FW_PROTO_HDR)

@@ -76,7 +76,7 @@ void Drone::begin(uint32_t now_ms) {
   out_.tilt = dp::SERVO_TILT_DEFAULT;
   out_.laser = false;
   enter(State::Disarmed);
-  char line[32];
+  char line[dp::REPLY_MAX_LENGTH];
   reply(line, dp::write_ready(line));
 }
 
@@ -86,7 +86,7 @@ void Drone::reply(const char* line, uint8_t length) {
 
 void Drone::receive(uint8_t byte, uint32_t now_ms) {
   now_ms_ = now_ms;
-  char line[32];
+  char line[dp::REPLY_MAX_LENGTH];
   if (parser_.feed(byte, now_ms)) {
     execute(parser_.command(), now_ms);
   } else if (parser_.last_error() != dp::Error::None) {
@@ -102,7 +102,7 @@ void Drone::execute(const dp::Command& c, uint32_t now_ms) {
   if (state_ == State::Failsafe) enter(armed_ ? State::Armed : State::Disarmed);
   result_ = dp::Error::None;
   dp::dispatch(c, *this);
-  char line[32];
+  char line[dp::REPLY_MAX_LENGTH];
   if (result_ == dp::Error::None) {
     reply(line, dp::write_accepted(c, line));
   } else {
@@ -176,7 +176,7 @@ void Drone::enter_failsafe() {
   // a radio failsafe (below its FS_THR_VALUE) and lands on its own.
   out_.throttle = dp::FAILSAFE_THROTTLE_US;
   out_.laser = false;
-  char line[32];
+  char line[dp::REPLY_MAX_LENGTH];
   reply(line, dp::write_failsafe(line));
 }
 

@@ -47,9 +47,9 @@ size_t rx_push(const uint8_t* data, size_t length) {
   while (taken < length && rx_space() > 0) g_rx.push_back(data[taken++]);
   return taken;
 }
-std::string tx_take() {
-  std::string out;
-  out.swap(g_tx);
+std::string tx_take(size_t max) {
+  std::string out = g_tx.substr(0, max);
+  g_tx.erase(0, out.size());
   return out;
 }
 uint32_t serial_baud() { return g_baud; }

@@ -19,9 +19,9 @@ uint32_t now();
 // (returns how many were taken).
 size_t rx_push(const uint8_t* data, size_t length);
 size_t rx_space();
-// Takes everything the firmware wrote since the last call (empties the TX
-// buffer as the UART would by sending it).
-std::string tx_take();
+// Takes up to `max` bytes the firmware wrote, as the UART would by sending
+// them; the rest stay in the 64-byte buffer and keep it full.
+std::string tx_take(size_t max = static_cast<size_t>(-1));
 uint32_t serial_baud();
 int pin(uint8_t pin);
 

@@ -10,7 +10,7 @@
 //   and then {"tick": t_ms}. Nothing depends on the wall clock.
 // --stdin: serial input from stdin instead of a pty, replies printed as
 //   {"t_ms":..,"tx":"..."}. With --clock stepped, stdin is a script of lines
-//   "rx <hex bytes>" and "step <ms>" (used by the tests).
+//   "rx <hex bytes>", "step <ms>" and "stats" (used by the tests).
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
@@ -39,7 +39,8 @@ struct Options {
 
 int g_master = -1;
 std::deque<uint8_t> g_pending;  // bytes "on the wire", not yet in the UART
-uint32_t g_byte_credit = 0;     // in 1/10000 byte units
+uint32_t g_byte_credit = 0;     // receive line, in 1/10000 byte units
+uint32_t g_tx_credit = 0;       // transmit line, same units
 uint32_t g_t = 0;
 bool g_first = true;
 drone::Outputs g_last;
@@ -81,14 +82,25 @@ void report_if_changed() {
       d.armed() ? "true" : "false", drone::state_name(d.state()));
 }
 
+// The UART sends what the baud rate allows in this millisecond.
 void send_replies() {
-  const std::string tx = fake::tx_take();
+  g_tx_credit += drone::dp::BAUD;
+  const std::string tx = fake::tx_take(g_tx_credit / 10000);
+  g_tx_credit -= static_cast<uint32_t>(tx.size()) * 10000;
+  if (g_tx_credit > 20000) g_tx_credit = 20000;
   if (tx.empty()) return;
   if (g_opt.use_stdin) {
-    std::string line = "{\"t_ms\":" + std::to_string(g_t) + ",\"tx\":";
-    json_string(line, tx);
-    line += "}\n";
-    fputs(line.c_str(), stdout);
+    // One JSON record per complete reply line, stamped when its '\n' left.
+    static std::string partial;
+    partial += tx;
+    size_t nl;
+    while ((nl = partial.find('\n')) != std::string::npos) {
+      std::string line = "{\"t_ms\":" + std::to_string(g_t) + ",\"tx\":";
+      json_string(line, partial.substr(0, nl + 1));
+      line += "}\n";
+      fputs(line.c_str(), stdout);
+      partial.erase(0, nl + 1);
+    }
   } else if (g_master >= 0) {
     // Non-blocking: with nobody reading, replies are lost, as on a real UART.
     ssize_t r = write(g_master, tx.data(), tx.size());
@@ -152,6 +164,18 @@ uint64_t wall_ms() {
   return static_cast<uint64_t>(ts.tv_sec) * 1000u + static_cast<uint64_t>(ts.tv_nsec) / 1000000u;
 }
 
+// Counters the JSON change lines do not carry: dropped replies and parser
+// errors per kind.
+void print_stats() {
+  const drone::Drone& d = drone_app::logic();
+  printf("{\"t_ms\":%u,\"replies_dropped\":%u,\"errors\":{", g_t, d.replies_dropped());
+  for (uint8_t i = 1; i <= drone::dp::PARSER_ERROR_COUNT; ++i) {
+    const drone::dp::Error e = static_cast<drone::dp::Error>(i);
+    printf("%s\"%s\":%u", i > 1 ? "," : "", drone::dp::error_name(e), d.parser().error_count(e));
+  }
+  printf("}}\n");
+}
+
 bool parse_hex(const char* s, std::deque<uint8_t>& out) {
   while (*s == ' ') ++s;
   while (s[0] && s[0] != '\n') {
@@ -179,6 +203,8 @@ int run_stepped() {
         fprintf(stderr, "bad hex: %s", line);
         return 2;
       }
+    } else if (g_opt.use_stdin && strncmp(line, "stats", 5) == 0) {
+      print_stats();
     } else if (strncmp(line, "quit", 4) == 0) {
       break;
     } else if (line[0] != '\n' && line[0] != '#') {
