@@ -246,7 +246,7 @@ class Controller:
             assert det is not None
             self._hits += 1
             self._misses = 0
-            self._search_sign = 1 if det.error_x >= 0 else -1
+            self._remember_side(det)
             if self._hits >= self.cfg.acquire_frames:
                 self._go(State.TRACK, f"seen in {self._hits} consecutive frames")
                 return self._on_track(det)
@@ -265,7 +265,7 @@ class Controller:
             self._pan_offset = self._tilt_offset = 0
             return self._emit(dp.servo_reset())
         ex, ey, size = det.error_x, det.error_y, det.relative_size
-        self._search_sign = 1 if ex >= 0 else -1
+        self._remember_side(det)
         if abs(ex) > cfg.dead_band_x:
             frac = 0.35 + 0.65 * min(1.0, abs(ex) / 0.5)
             if ex > 0:
@@ -281,6 +281,11 @@ class Controller:
             return self._on_aim(det)
         frac = 1.8 if size < 0.45 * cfg.approach_size else (1.0 if size < 0.75 * cfg.approach_size else 0.6)
         return self._emit(dp.move_forward(_speed("move_forward", frac)))
+
+    def _remember_side(self, det: Detection) -> None:
+        """Which way to sweep if the target is lost: its bearing from the body (camera pan included)."""
+        bearing = self._pan_offset + math.degrees(math.atan(det.error_x * self._tan_h))
+        self._search_sign = 1 if bearing >= 0 else -1
 
     def _servo_correction(self, det: Detection) -> bytes | None:
         """One pan or tilt step towards the target, the larger error first; None when centred."""
@@ -308,6 +313,7 @@ class Controller:
             return self._to_search("target lost while aiming")
         if det is None or not det.found:
             return self._emit(dp.hold_altitude())
+        self._remember_side(det)
         if det.relative_size < self.cfg.retreat_size:
             self._go(State.TRACK, f"target receded (size {det.relative_size:.3f})")
             return self._on_track(det)
@@ -337,6 +343,7 @@ class Controller:
                 self._go(State.SEARCH, "target lost while firing")
             return off if off is not None else self._emit(dp.hold_altitude())
         self._misses = 0
+        self._remember_side(det)
         loose = 2.0 * self.cfg.aim_tolerance
         if abs(det.error_x) > loose or abs(det.error_y) > loose:
             off = self._laser(False)

@@ -1,0 +1,10 @@
+"""``python -m pilot``."""
+
+from __future__ import annotations
+
+import sys
+
+from pilot.cli import main
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,259 @@
+"""``python -m pilot`` / ``pilot``: fly the simulated room (the default) or a real drone.
+
+    pilot                                    # simulated room, virtual drone, default scenario
+    pilot --scenario behind --seed 4 --record out/
+    pilot --port /dev/ttyACM0 --arm --camera 0
+    pilot --video flight.mp4 --dry-run       # decide and print the commands, send nothing
+    pilot --calibrate sample.png --config pilot.yaml   # HSV ranges from a sample image into the config
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import signal
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from types import FrameType
+
+import drone_protocol as dp
+
+from pilot import config as config_mod
+from pilot.calibrate import Roi, calibrate_to_config
+from pilot.config import PilotConfig
+from pilot.controller import Controller, State
+from pilot.detect import make_detector
+from pilot.errors import PilotError
+from pilot.link import Link, LogEntry, keepalive_ms
+from pilot.record import Recorder
+from pilot.runner import DryRunSink, Observer, RealPacer, Sink, StatusLine, run
+from pilot.sim.camera import CameraModel, CameraPose, Renderer
+from pilot.sim.flight import fly
+from pilot.sim.room import SCENARIOS, make_scenario
+from pilot.sources import CameraSource, Frame, FrameSource, ImageFolderSource, VideoFileSource
+
+EXIT_OK = 0
+EXIT_FAILED = 1
+EXIT_USAGE = 2
+EXIT_INTERRUPTED = 130
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="pilot", description="The Raspberry Pi vision pilot of the drone.")
+    where = p.add_argument_group("where to fly")
+    where.add_argument("--sim", action="store_true", help="fly the simulated room (the default without --port)")
+    where.add_argument("--port", help="serial port or pyserial URL of the drone's Arduino (e.g. /dev/ttyACM0)")
+    where.add_argument("--baud", type=int, default=dp.BAUD, help=f"baud rate (default {dp.BAUD}, from the spec)")
+    where.add_argument("--arm", action="store_true", help="allow arming a real drone (required with --port)")
+    src = p.add_argument_group("frames (real flights and --dry-run)")
+    src.add_argument("--camera", help="camera index or device (default 0 with --port)")
+    src.add_argument("--video", help="a video file as the frame source")
+    src.add_argument("--images", help="a folder of images as the frame source")
+    p.add_argument("--detector", choices=config_mod.DETECTORS, help="target detector (default: config, else hsv)")
+    p.add_argument("--config", help="YAML config file (see pilot/config.py for every option)")
+    p.add_argument("--dry-run", action="store_true", help="decide and print the commands, send nothing")
+    p.add_argument("--record", metavar="DIR", help="write the annotated video, the JSON-lines log and the path picture")
+    p.add_argument("--seed", type=int, default=1, help="simulated room seed (default 1)")
+    p.add_argument("--scenario", choices=SCENARIOS, default="ahead", help="simulated scenario (default ahead)")
+    p.add_argument("--max-seconds", type=float, default=60.0, help="flight time limit, seconds (default 60)")
+    p.add_argument("--size", default="320x240", help="simulated camera frame size (default 320x240)")
+    p.add_argument("--virtual-drone", help="the virtual drone executable (default: the firmware's host build)")
+    p.add_argument("--no-status", action="store_true", help="no status line")
+    cal = p.add_argument_group("calibration")
+    cal.add_argument("--calibrate", metavar="IMAGE", help="pick HSV ranges from IMAGE and save them to --config")
+    cal.add_argument("--roi", help="x,y,w,h of the target in the calibration image (default: the central 20%%)")
+    return p
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, handled like Ctrl-C: the safe sequence goes out before the program ends."""
+
+
+def _on_sigterm(signum: int, frame: FrameType | None) -> None:
+    raise _Terminated(f"signal {signum}")
+
+
+def _load_config(args: argparse.Namespace) -> PilotConfig:
+    cfg = config_mod.load(args.config) if args.config else PilotConfig()
+    if args.detector:
+        cfg = dataclasses.replace(cfg, detector=args.detector)
+    return config_mod.validate(cfg, args.config or "command line")
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError as exc:
+        raise PilotError(f"option --size: expected WIDTHxHEIGHT, got {text!r}") from exc
+    if w < 32 or h < 24:
+        raise PilotError(f"option --size: {text!r} is too small")
+    return w, h
+
+
+def _roi(text: str | None) -> Roi | None:
+    if text is None:
+        return None
+    try:
+        x, y, w, h = (int(v) for v in text.split(","))
+    except ValueError as exc:
+        raise PilotError(f"option --roi: expected x,y,w,h, got {text!r}") from exc
+    return (x, y, w, h)
+
+
+class _StillSim:
+    """--dry-run without a frame source: the simulated room seen from the start pose, at altitude."""
+
+    def __init__(self, scenario_name: str, seed: int, size: tuple[int, int]) -> None:
+        self.scenario = make_scenario(scenario_name, seed)
+        self.renderer = Renderer(self.scenario, CameraModel(*size))
+        x, y, heading = self.scenario.start
+        self.pose = CameraPose.from_drone(x, y, 1.2, heading, 90.0, 90.0)
+        self._index = 0
+
+    def read(self) -> Frame | None:
+        frame = Frame(self.renderer.render(self.pose, self._index * 0.05), self._index * 0.05, self._index)
+        self._index += 1
+        return frame
+
+    def close(self) -> None:
+        pass
+
+    def __enter__(self) -> _StillSim:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def _frame_source(args: argparse.Namespace) -> FrameSource | _StillSim:
+    if args.video:
+        return VideoFileSource(args.video)
+    if args.images:
+        return ImageFolderSource(args.images)
+    if args.camera is not None or args.port:
+        cam = args.camera if args.camera is not None else "0"
+        return CameraSource(int(cam) if cam.isdigit() else cam)
+    return _StillSim(args.scenario, args.seed, _size(args.size))
+
+
+def _fly_sim(args: argparse.Namespace, cfg: PilotConfig) -> int:
+    observers: list[Observer] = []
+    status = None if args.no_status else StatusLine()
+    if status is not None:
+        observers.append(status)
+    result = fly(
+        args.scenario,
+        args.seed,
+        config=cfg,
+        max_seconds=args.max_seconds,
+        record_dir=args.record,
+        camera=CameraModel(*_size(args.size)),
+        executable=args.virtual_drone,
+        observers=observers,
+    )
+    if status is not None:
+        status.finish()
+    print(result.summary())
+    if result.record_dir:
+        print(f"recording: {result.video}")
+        print(f"log:       {Path(result.record_dir) / 'log.jsonl'}")
+        print(f"path:      {result.path_picture}")
+    if result.error:
+        print(f"pilot: stopped by {result.error}", file=sys.stderr)
+    if result.error and "KeyboardInterrupt" in result.error:
+        return EXIT_INTERRUPTED
+    return EXIT_OK if result.success and result.wall_hits == 0 else EXIT_FAILED
+
+
+def _fly_real(args: argparse.Namespace, cfg: PilotConfig) -> int:
+    if args.port and not args.dry_run and not args.arm:
+        print(
+            f"pilot: refusing to fly the drone on {args.port}: arming a real drone needs --arm "
+            "(or use --dry-run to print the commands without sending them)",
+            file=sys.stderr,
+        )
+        return EXIT_USAGE
+    recorder = Recorder(args.record, fps=cfg.link.rate_hz) if args.record else None
+    observers: list[Observer] = []
+    status = None if args.no_status else StatusLine()
+    if status is not None:
+        observers.append(status)
+    if recorder is not None:
+        observers.append(recorder)
+
+    def link_log(entry: LogEntry) -> None:
+        if recorder is not None:
+            recorder.on_link(entry)
+
+    link: Link | None = None
+    try:
+        with _frame_source(args) as source:
+            sink: Sink
+            if args.dry_run:
+                sink = DryRunSink()
+            else:
+                link = Link(
+                    args.port,
+                    args.baud,
+                    ready_timeout_s=cfg.link.ready_timeout_s,
+                    reconnect_s=cfg.link.reconnect_s,
+                    log=link_log,
+                ).open()
+                sink = link
+            controller = Controller(cfg.controller)
+            result = run(
+                source,
+                make_detector(cfg),
+                controller,
+                sink,
+                RealPacer(cfg.link.rate_hz),
+                max_seconds=args.max_seconds,
+                keepalive_ms=keepalive_ms(cfg.link.keepalive_fraction),
+                observers=observers,
+            )
+    finally:
+        if link is not None:
+            link.close()
+        if recorder is not None:
+            recorder.write({"result": {"note": "real flight: no position, so no path picture"}})
+            recorder.close()
+        if status is not None:
+            status.finish()
+    print(f"pilot: {result.reason}; final state {result.state.value}; laser fired: {result.fired}")
+    for problem in result.shutdown_errors:
+        print(f"pilot: during the safe shutdown: {problem}", file=sys.stderr)
+    if recorder is not None:
+        print(f"recording: {recorder.video_path}\nlog:       {recorder.log_path}")
+    if isinstance(result.error, KeyboardInterrupt):
+        return EXIT_INTERRUPTED
+    if result.error is not None and not isinstance(result.error, PilotError):
+        print(f"pilot: stopped by {type(result.error).__name__}: {result.error}", file=sys.stderr)
+    return EXIT_OK if result.state is State.DONE and result.error is None else EXIT_FAILED
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    try:
+        if args.calibrate:
+            if not args.config:
+                raise PilotError("option --calibrate needs --config FILE to save the ranges into")
+            cfg = calibrate_to_config(args.calibrate, args.config, _roi(args.roi))
+            print(f"pilot: saved HSV ranges {cfg.hsv.ranges} to {args.config}")
+            return EXIT_OK
+        cfg = _load_config(args)
+        if args.port and args.sim:
+            raise PilotError("options --sim and --port exclude each other")
+        if args.port or args.dry_run or args.camera is not None or args.video or args.images:
+            if not args.port:
+                args.dry_run = True  # frames without a drone: decide and print
+            return _fly_real(args, cfg)
+        return _fly_sim(args, cfg)
+    except PilotError as exc:
+        print(f"pilot: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        return EXIT_INTERRUPTED
+    finally:
+        signal.signal(signal.SIGTERM, previous)
