@@ -106,8 +106,8 @@ static double best_seconds(Loop loop, const std::vector<uint8_t>& stream, int pa
 
 int main(int argc, char** argv) {
   const char* mode = argc > 1 ? argv[1] : "time";
-  const size_t frames = argc > 2 ? static_cast<size_t>(std::strtoul(argv[2], nullptr, 10)) : 1000000u;
-  const int passes = argc > 3 ? std::atoi(argv[3]) : 15;
+  const size_t frames = argc > 2 ? static_cast<size_t>(std::strtoul(argv[2], nullptr, 10)) : 100000u;
+  const int passes = argc > 3 ? std::atoi(argv[3]) : 200;
   const std::vector<uint8_t> stream = make_stream(frames);
   std::vector<uint8_t> target(stream.size());
   memcpy_target = target.data();
