@@ -71,6 +71,8 @@ class Link:
         clock: Callable[[], float] = time.monotonic,
         sleep: Callable[[float], None] = time.sleep,
         log: Callable[[LogEntry], None] | None = None,
+        ready_clock: Callable[[], float] | None = None,
+        ready_sleep: Callable[[float], None] | None = None,
     ) -> None:
         self._url = port if isinstance(port, str) else None
         self._port: Any = None if isinstance(port, str) else port
@@ -80,6 +82,9 @@ class Link:
         self.wait_ready = wait_ready
         self._clock = clock
         self._sleep = sleep
+        # the ready-line wait may use its own clock (the simulator waits for the kernel, not for sim time)
+        self._ready_clock = ready_clock or clock
+        self._ready_sleep = ready_sleep or sleep
         self._log = log
         self._buffer = bytearray()
         self._closed = False
@@ -127,7 +132,7 @@ class Link:
     def await_ready(self, timeout_s: float | None = None) -> dp.Reply:
         """Read lines until the ready line; refuse another spec's fingerprint."""
         limit = self.ready_timeout_s if timeout_s is None else timeout_s
-        deadline = self._clock() + limit
+        deadline = self._ready_clock() + limit
         while True:
             for line in self._read_lines():
                 try:
@@ -142,12 +147,12 @@ class Link:
                         raise FingerprintMismatch(f"{dp.PROTOCOL_NAME} {dp.SPEC_FINGERPRINT}", theirs)
                     self.ready = reply
                     return reply
-            if self._clock() >= deadline:
+            if self._ready_clock() >= deadline:
                 raise ReadyTimeout(
                     f"link {self.name!r}: no ready line ('{dp.ReplyKind.READY.value} {dp.PROTOCOL_NAME} ...') "
                     f"within {limit:.1f} s; is the drone firmware running on this port?"
                 )
-            self._sleep(0.005)
+            self._ready_sleep(0.005)
 
     # -- I/O ----------------------------------------------------------------------------------------
     def _read_lines(self) -> list[bytes]:

@@ -109,9 +109,6 @@ def fly(
             ) as world,
         ):
 
-            def sim_sleep(seconds: float) -> None:
-                world.advance(max(1, round(seconds * 1000.0)))
-
             def link_log(entry: LogEntry) -> None:
                 if recorder is not None:
                     recorder.on_link(entry)
@@ -121,8 +118,12 @@ def fly(
                 ready_timeout_s=cfg.link.ready_timeout_s,
                 reconnect_s=cfg.link.reconnect_s,
                 clock=world.now,
-                sleep=sim_sleep,
                 log=link_log,
+                # the firmware has sent its ready line by now (SimWorld boots it for BOOT_MS); what is
+                # left is the kernel moving the bytes through the pty: wait for that in real time, so
+                # that the flight's simulated timeline does not depend on it
+                ready_clock=time.monotonic,
+                ready_sleep=time.sleep,
             )
             with link:
                 controller = Controller(cfg.controller, clock=world.now)

@@ -20,6 +20,8 @@ from pilot.sim.room import Scenario
 from pilot.sim.virtual import Change, VirtualDrone
 from pilot.sources import Frame
 
+BOOT_MS = 20  # the firmware boots and sends its ready line (39 bytes at 115200 baud: under 4 ms)
+
 
 @dataclass
 class FlightScore:
@@ -56,7 +58,7 @@ class SimWorld:
         self.aim_point = aim_point
         self.lose_camera_at_s = lose_camera_at_s
         self.score = FlightScore()
-        changes = vd.step(1)
+        changes = vd.step(BOOT_MS)
         if vd.outputs is None:
             raise SimulatorError("virtual drone reported no outputs at boot")
         self.outputs: Outputs = vd.outputs

@@ -38,6 +38,11 @@ def name(frame: bytes | None) -> str:
     return dp.decode(frame).name
 
 
+def st(c: Controller) -> State:
+    """The state, read through a call so that the type checker does not narrow it between updates."""
+    return c.state
+
+
 def tick(c: Controller, clock: Clock, det: Detection | None, ms: float = 50.0) -> bytes | None:
     out = c.update(det)
     clock.advance_ms(ms)
@@ -51,53 +56,54 @@ def to_state(state: State, cfg: ControllerConfig = CFG) -> tuple[Controller, Clo
     c.start()
     order = [State.ARM, State.TAKEOFF, State.HOLD, State.SEARCH, State.ACQUIRE, State.TRACK, State.AIM, State.FIRE]
     for _ in range(2000):
-        if c.state is state:
+        if st(c) is state:
             return c, clock
-        if c.state in (State.ARM, State.TAKEOFF, State.HOLD):
+        if st(c) in (State.ARM, State.TAKEOFF, State.HOLD):
             tick(c, clock, MISS)
-        elif c.state in (State.SEARCH, State.ACQUIRE, State.TRACK):
+        elif st(c) in (State.SEARCH, State.ACQUIRE, State.TRACK):
             tick(c, clock, seen(size=0.3) if order.index(state) > order.index(State.TRACK) else seen())
-        elif c.state is State.AIM:
+        elif st(c) is State.AIM:
             tick(c, clock, seen(size=0.3))
         else:
             break
-    raise AssertionError(f"did not reach {state}, stuck in {c.state}")
+    raise AssertionError(f"did not reach {state}, stuck in {st(c)}")
 
 
 def test_arm_takeoff_hold_search_timing() -> None:
     clock = Clock()
     c = Controller(CFG, clock=clock)
-    assert c.state is State.IDLE and c.update(MISS) is None
+    assert st(c) is State.IDLE and c.update(MISS) is None
     c.start()
-    assert c.state is State.ARM
+    assert st(c) is State.ARM
     assert name(tick(c, clock, MISS)) == "arm"
     # nothing new until the firmware's arming hold (from the spec) plus the margin has passed
     waited = 50
     while waited < dp.ARMING_HOLD_MS + CFG.arm_margin_ms:
         assert tick(c, clock, MISS) is None
-        assert c.state is State.ARM
+        assert st(c) is State.ARM
         waited += 50
     out = tick(c, clock, MISS)
-    assert c.state is State.TAKEOFF and name(out) == "move_up"
-    assert dp.decode(out).value > dp.CHANNELS["throttle"].median  # type: ignore[arg-type]
+    assert st(c) is State.TAKEOFF and name(out) == "move_up"
+    assert out is not None
+    assert (dp.decode(out).value or 0) > dp.CHANNELS["throttle"].median
     for _ in range(CFG.takeoff_ms // 50 - 1):
         assert name(tick(c, clock, MISS)) == "move_up"
-    assert name(tick(c, clock, MISS)) == "hold_altitude" and c.state is State.HOLD
+    assert name(tick(c, clock, MISS)) == "hold_altitude" and st(c) is State.HOLD
     for _ in range(CFG.settle_ms // 50 - 1):
         assert name(tick(c, clock, MISS)) == "hold_altitude"
-    assert name(tick(c, clock, MISS)) == "turn_right" and c.state is State.SEARCH
+    assert name(tick(c, clock, MISS)) == "turn_right" and st(c) is State.SEARCH
     assert [t.new for t in c.transitions] == [State.ARM, State.TAKEOFF, State.HOLD, State.SEARCH]
 
 
 def test_search_is_bounded_then_lands() -> None:
     c, clock = to_state(State.SEARCH)
     n = 0
-    while c.state is State.SEARCH:
+    while st(c) is State.SEARCH:
         out = tick(c, clock, MISS, ms=100)
         n += 1
-        if c.state is State.SEARCH:
+        if st(c) is State.SEARCH:
             assert name(out) == "turn_right"
-    assert c.state is State.LAND
+    assert st(c) is State.LAND
     assert abs(n * 100 - CFG.search_max_ms) <= 100
     assert c.transitions[-1].reason == "search sweep exhausted"
 
@@ -105,14 +111,14 @@ def test_search_is_bounded_then_lands() -> None:
 def test_acquire_needs_consecutive_frames() -> None:
     c, clock = to_state(State.SEARCH)
     assert name(tick(c, clock, seen(0.3))) == "hold_altitude"  # stop turning
-    assert c.state is State.ACQUIRE
+    assert st(c) is State.ACQUIRE
     out = tick(c, clock, MISS)
-    assert c.state is State.SEARCH and name(out) == "hold_altitude"
+    assert st(c) is State.SEARCH and name(out) == "hold_altitude"
     for _ in range(CFG.acquire_frames - 1):
         tick(c, clock, seen(0.3))
-        assert c.state is State.ACQUIRE
+        assert st(c) is State.ACQUIRE
     out = tick(c, clock, seen(0.3))
-    assert c.state is State.TRACK and name(out) == "turn_right"
+    assert st(c) is State.TRACK and name(out) == "turn_right"
 
 
 @pytest.mark.parametrize(
@@ -130,9 +136,10 @@ def test_acquire_needs_consecutive_frames() -> None:
 def test_track_dead_bands(ex: float, ey: float, expected: str) -> None:
     c, clock = to_state(State.TRACK)
     out = tick(c, clock, seen(ex, ey, size=0.05))
-    assert c.state is State.TRACK
+    assert st(c) is State.TRACK
     assert name(out) == expected
-    value = dp.decode(out).value  # type: ignore[arg-type]
+    assert out is not None
+    value = dp.decode(out).value or 0
     spec = dp.COMMANDS[expected]
     median = dp.CHANNELS[spec.target].median
     assert spec.minimum <= value <= spec.maximum
@@ -150,14 +157,14 @@ def test_turn_speed_grows_with_the_error() -> None:
 def test_track_to_aim_with_size_hysteresis() -> None:
     c, clock = to_state(State.TRACK)
     tick(c, clock, seen(size=CFG.approach_size * 0.99))
-    assert c.state is State.TRACK
+    assert st(c) is State.TRACK
     tick(c, clock, seen(size=CFG.approach_size))
-    assert c.state is State.AIM
+    assert st(c) is State.AIM
     between = (CFG.approach_size + CFG.retreat_size) / 2
     tick(c, clock, seen(size=between))
-    assert c.state is State.AIM  # hysteresis: stays
+    assert st(c) is State.AIM  # hysteresis: stays
     out = tick(c, clock, seen(size=CFG.retreat_size * 0.95))
-    assert c.state is State.TRACK and name(out) == "move_forward"
+    assert st(c) is State.TRACK and name(out) == "move_forward"
 
 
 @pytest.mark.parametrize(
@@ -167,8 +174,8 @@ def test_track_to_aim_with_size_hysteresis() -> None:
 def test_aim_corrects_with_pan_tilt(ex: float, ey: float, expected: str) -> None:
     c, clock = to_state(State.AIM)
     out = tick(c, clock, seen(ex, ey, size=0.25))
-    assert c.state is State.AIM and name(out) == expected
-    assert 1 <= (dp.decode(out).value or 0) <= 180
+    assert st(c) is State.AIM and name(out) == expected
+    assert out is not None and 1 <= (dp.decode(out).value or 0) <= 180
 
 
 def test_aim_then_fire_then_laser_timeout_then_land_and_disarm() -> None:
@@ -177,22 +184,22 @@ def test_aim_then_fire_then_laser_timeout_then_land_and_disarm() -> None:
     assert name(out) == "servo_right"
     for _ in range(CFG.aim_frames - 1):
         assert name(tick(c, clock, seen(size=0.25))) == "hold_altitude"
-        assert not c.laser_on and c.state is State.AIM
+        assert not c.laser_on and st(c) is State.AIM
     out = tick(c, clock, seen(size=0.25))
-    assert c.state is State.FIRE and name(out) == "laser_toggle" and c.laser_on
+    assert st(c) is State.FIRE and name(out) == "laser_toggle" and c.laser_on
     lit = 50
-    while c.state is State.FIRE:
+    while st(c) is State.FIRE:
         out = tick(c, clock, seen(size=0.25))
         lit += 50
-        if c.state is State.FIRE:
+        if st(c) is State.FIRE:
             assert name(out) == "hold_altitude"
     assert name(out) == "laser_toggle" and not c.laser_on  # off after the set time
-    assert c.state is State.LAND and c.fired
+    assert st(c) is State.LAND and c.fired
     assert abs(lit - CFG.fire_ms) <= 50
     frames = []
-    while c.state is State.LAND:
+    while st(c) is State.LAND:
         frames.append(name(tick(c, clock, MISS)))
-    assert c.state is State.DONE
+    assert st(c) is State.DONE
     assert frames[-1] == "disarm"
     assert set(frames[:-1]) <= {"move_down", "servo_reset"}
     assert tick(c, clock, MISS) is None
@@ -202,11 +209,11 @@ def test_laser_only_while_locked_and_centred() -> None:
     c, clock = to_state(State.FIRE)
     assert c.laser_on
     out = tick(c, clock, MISS)  # one missed frame: off at once, still firing
-    assert name(out) == "laser_toggle" and not c.laser_on and c.state is State.FIRE
+    assert name(out) == "laser_toggle" and not c.laser_on and st(c) is State.FIRE
     out = tick(c, clock, seen(size=0.25))  # re-found and centred: on again
     assert name(out) == "laser_toggle" and c.laser_on
     out = tick(c, clock, seen(0.3, 0.0, size=0.25))  # off centre: off, back to aiming
-    assert name(out) == "laser_toggle" and not c.laser_on and c.state is State.AIM
+    assert name(out) == "laser_toggle" and not c.laser_on and st(c) is State.AIM
 
 
 @pytest.mark.parametrize("state", [State.TRACK, State.AIM, State.FIRE])
@@ -214,7 +221,7 @@ def test_target_lost_means_laser_off_neutral_and_search(state: State) -> None:
     c, clock = to_state(state)
     tick(c, clock, seen(-0.05, size=0.25 if state is not State.TRACK else 0.05))
     frames = [tick(c, clock, MISS) for _ in range(CFG.lost_frames)]
-    assert c.state is State.SEARCH
+    assert st(c) is State.SEARCH
     assert not c.laser_on
     names = [name(f) for f in frames if f is not None]
     assert "hold_altitude" in names  # sticks neutral
@@ -230,43 +237,43 @@ def test_refound_after_loss_goes_through_acquire_again() -> None:
     c, clock = to_state(State.TRACK)
     for _ in range(CFG.lost_frames):
         tick(c, clock, MISS)
-    assert c.state is State.SEARCH
+    assert st(c) is State.SEARCH
     tick(c, clock, seen(0.2))
-    assert c.state is State.ACQUIRE
+    assert st(c) is State.ACQUIRE
     for _ in range(CFG.acquire_frames):
         tick(c, clock, seen(0.2))
-    assert c.state is State.TRACK
+    assert st(c) is State.TRACK
 
 
 def test_failsafe_reply_switches_laser_belief_off_and_lands() -> None:
-    c, clock = to_state(State.FIRE)
+    c, _clock = to_state(State.FIRE)
     c.on_reply(dp.parse_reply(dp.failsafe_line()))
-    assert not c.laser_on and c.state is State.LAND
+    assert not c.laser_on and st(c) is State.LAND
     assert "failsafe" in c.transitions[-1].reason
 
 
 def test_not_armed_reply_lands() -> None:
-    c, clock = to_state(State.TRACK)
+    c, _clock = to_state(State.TRACK)
     c.on_reply(dp.parse_reply(dp.rejected_line(dp.ErrorKind.NOT_ARMED)))
-    assert c.state is State.LAND
+    assert st(c) is State.LAND
 
 
 def test_busy_reply_during_arming_is_ignored() -> None:
-    c, clock = to_state(State.ARM)
+    c, _clock = to_state(State.ARM)
     c.on_reply(dp.parse_reply(dp.rejected_line(dp.ErrorKind.BUSY)))
-    assert c.state is State.ARM
+    assert st(c) is State.ARM
 
 
 def test_safe_sequence_with_laser_on() -> None:
-    c, clock = to_state(State.FIRE)
+    c, _clock = to_state(State.FIRE)
     c.abort("test")
     frames = c.safe_sequence()
     assert [name(f) for f in frames] == ["laser_toggle", "hold_altitude", "servo_reset", "move_down", "disarm"]
-    assert not c.laser_on and c.state is State.DONE
+    assert not c.laser_on and st(c) is State.DONE
 
 
 def test_safe_sequence_with_laser_off_has_no_toggle() -> None:
-    c, clock = to_state(State.TRACK)
+    c, _clock = to_state(State.TRACK)
     assert [name(f) for f in c.safe_sequence()] == ["hold_altitude", "servo_reset", "move_down", "disarm"]
 
 
@@ -274,8 +281,8 @@ def test_config_changes_take_effect() -> None:
     cfg = dataclasses.replace(CFG, acquire_frames=1, fire_ms=200)
     c, clock = to_state(State.SEARCH, cfg)
     tick(c, clock, seen())
-    assert c.state is State.TRACK  # one frame is enough
+    assert st(c) is State.TRACK  # one frame is enough
     c, clock = to_state(State.FIRE, cfg)
     for _ in range(4):
         tick(c, clock, seen(size=0.3))
-    assert c.state is State.LAND
+    assert st(c) is State.LAND
