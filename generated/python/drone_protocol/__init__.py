@@ -550,10 +550,8 @@ def _command(spec: CommandSpec, value: int) -> Command:
     return command
 
 
-def decode(frame: bytes) -> Command:
-    """Decode exactly one frame; raise a ProtocolError subclass naming the bad byte and what was allowed."""
-    if frame.__class__ is not bytes:
-        frame = bytes(frame)
+def _valid(frame: bytes) -> Command | None:
+    """The command of a valid frame, or None (then the slow path says what is wrong)."""
     command = _DECODED.get(frame)
     if command is not None:
         return command
@@ -567,6 +565,16 @@ def decode(frame: bytes) -> Command:
                     _DECODED.clear()
                 command = _DECODED[frame] = _command(spec, value)
                 return command
+    return None
+
+
+def decode(frame: bytes) -> Command:
+    """Decode exactly one frame; raise a ProtocolError subclass naming the bad byte and what was allowed."""
+    if frame.__class__ is not bytes:
+        frame = bytes(frame)
+    command = _valid(frame)
+    if command is not None:
+        return command
     # Invalid: find the first bad byte and say what was allowed there.
     if len(frame) != FRAME_LENGTH:
         if len(frame) < FRAME_LENGTH:
@@ -614,8 +622,18 @@ class StreamDecoder:
         if data:
             self._last = now
         out: list[Command] = []
-        for byte in data:
-            buffer.append(byte)
+        i, n = 0, len(data)
+        while i < n:
+            # Between frames, a whole valid frame takes decode's fast path; the byte-at-a-time slide below would
+            # find exactly the same frame with no error (every prefix of a valid frame is valid).
+            if not buffer and n - i >= FRAME_LENGTH:
+                command = _valid(bytes(data[i:i + FRAME_LENGTH]))
+                if command is not None:
+                    out.append(command)
+                    i += FRAME_LENGTH
+                    continue
+            buffer.append(data[i])
+            i += 1
             while buffer:
                 frame = bytes(buffer)
                 if len(buffer) == FRAME_LENGTH:
@@ -746,8 +764,20 @@ class Reply:
 _REPLY_PREFIXES: Final = tuple(sorted(ReplyKind, key=lambda k: -len(k.value)))
 
 
+# Every accepted, rejected and failsafe line is known in advance: those parse with one lookup.
+_KNOWN_REPLIES: Final[Mapping[bytes, Reply]] = {
+    **{f"{ReplyKind.ACCEPTED.value}{s.category.value}{s.direction.value}".encode("ascii"):
+       Reply(ReplyKind.ACCEPTED, category=s.category, direction=s.direction.value) for s in COMMANDS.values()},
+    **{f"{ReplyKind.REJECTED.value}{k.value}".encode("ascii"): Reply(ReplyKind.REJECTED, error=k) for k in ErrorKind},
+    ReplyKind.FAILSAFE.value.encode("ascii"): Reply(ReplyKind.FAILSAFE),
+}
+
+
 def parse_reply(line: bytes) -> Reply:
     """Parse one reply line (with or without its newline)."""
+    known = _KNOWN_REPLIES.get(line.rstrip(b"\r\n"))
+    if known is not None:
+        return known
     text = line.rstrip(b"\r\n").decode("ascii", errors="replace")
     for kind in _REPLY_PREFIXES:
         if not text.startswith(kind.value):

@@ -431,6 +431,8 @@ class StreamParser {
     }
     last_ms_ = now_ms;
     buffer_[length_++] = byte;
+    // A value digit that does not end the frame needs no table walk: the prefix before it is valid.
+    if (length_ > 2 && length_ < FRAME_LENGTH && static_cast<uint8_t>(byte - '0') <= 9u) return false;
     // Only the new byte needs checking while the prefix is valid; after a slide, every byte does.
     uint8_t from = static_cast<uint8_t>(length_ - 1);
     while (length_ > 0) {
