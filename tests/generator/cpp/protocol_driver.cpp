@@ -2,7 +2,8 @@
 //
 //   protocol_driver decode   stdin: one frame per line in hex (an empty line is a 0-byte frame)
 //                            stdout: "ok <command> <category byte> <direction byte> <value>" or "err <error name>"
-//   protocol_driver stream   stdin: "<now_ms> <hex bytes>" per line, fed one byte at a time at that time
+//   protocol_driver stream   stdin: "<now_ms> <hex bytes>" per line, fed one byte at a time at that time;
+//                            "mark" (echoed, to locate frames in the output)
 //                            stdout: "frame <hex>" for every frame the StreamParser emits (re-encoded), then
 //                            "pending <n>" and one "count <error name> <n>" per parser error kind
 //
@@ -75,6 +76,10 @@ static int run_stream() {
   static uint8_t bytes[1 << 15];
   StreamParser parser;
   while (fgets(line, sizeof line, stdin) != nullptr) {
+    if (strncmp(line, "mark", 4) == 0) {
+      printf("mark\n");
+      continue;
+    }
     char* rest = nullptr;
     const unsigned long now = strtoul(line, &rest, 10);
     while (*rest == ' ') ++rest;
