@@ -178,6 +178,10 @@ class Renderer:
             if c[2] > NEAR + sc.marker.side:
                 items.append((float(c[2]), sc.marker))
         items.sort(key=lambda item: -item[0])
+        # poles first: the marker plate hangs on the target's pole and must cover it at any tilt
+        for _, item in items:
+            if isinstance(item, Ball):
+                self._draw_pole(img, pose, item)
         for _, item in items:
             if isinstance(item, Ball):
                 self._draw_ball(img, pose, item)
@@ -193,7 +197,7 @@ class Renderer:
         self._count += 1
         return out
 
-    def _draw_ball(self, img: Image, pose: CameraPose, ball: Ball) -> None:
+    def _draw_pole(self, img: Image, pose: CameraPose, ball: Ball) -> None:
         x, y, z = ball.position
         pole = self._to_camera(pose, np.array([[x, y, z - ball.radius], [x, y, 0.0]]))
         clipped = self._clip_near(np.vstack([pole, pole[::-1]]))
@@ -204,6 +208,8 @@ class Renderer:
             p0 = np.round(uv[0] * ONE).astype(np.int32)
             p1 = np.round(uv[len(uv) // 2] * ONE).astype(np.int32)
             cv2.line(img, (int(p0[0]), int(p0[1])), (int(p1[0]), int(p1[1])), POLE, thick, cv2.LINE_8, SHIFT)
+
+    def _draw_ball(self, img: Image, pose: CameraPose, ball: Ball) -> None:
         c = self._to_camera(pose, np.array([ball.position]))[0]
         uv = self._project(c)
         radius = self._focal * ball.radius / c[2]
