@@ -1,0 +1,200 @@
+// libFuzzer target for the generated DroneProtocol.h: StreamParser, decode and encode.
+//
+// Input: a byte stream fed to a StreamParser one byte at a time. 0xFF n advances the clock by n ms (0xFF 0xFF
+// feeds 0xFF itself), so inter-byte timeouts are explored too. The same input also drives decode() on every
+// 6-byte window and on the whole input, and encode() on (command, value) triples read from it.
+//
+// Invariants checked (a failure aborts, which libFuzzer reports as a crash):
+// - the parser agrees after every byte with a small reference model written from the spec's rules (same frames,
+//   same pending bytes, same error counts by kind);
+// - pending() <= FRAME_LENGTH - 1; a frame is emitted only when its last byte arrives, and it is exactly the
+//   last FRAME_LENGTH bytes fed;
+// - every emitted or decoded command lies in its command's range, matches its CommandInfo and re-encodes to
+//   the same bytes; encode() succeeds exactly for values in range, and its frame decodes back;
+// - error_name()/error_code() are total.
+#include <DroneProtocol.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+using namespace drone_protocol;
+
+#define CHECK(cond)                                                              \
+  do {                                                                           \
+    if (!(cond)) {                                                               \
+      fprintf(stderr, "invariant failed at %s:%d: %s\n", __FILE__, __LINE__, #cond); \
+      abort();                                                                   \
+    }                                                                            \
+  } while (0)
+
+namespace {
+
+// The command with these two bytes, by a plain scan of command_info() (independent of the parser's tables).
+int find(uint8_t category, uint8_t direction) {
+  for (uint8_t i = 0; i < COMMAND_COUNT; ++i) {
+    const CommandInfo info = command_info(static_cast<CommandId>(i));
+    if (info.category == category && info.direction == direction) return i;
+  }
+  return -1;
+}
+
+bool is_category(uint8_t byte) {
+  for (uint8_t i = 0; i < COMMAND_COUNT; ++i) {
+    if (command_info(static_cast<CommandId>(i)).category == byte) return true;
+  }
+  return false;
+}
+
+// The first problem of buf[0..len) read as the start of a frame; Error::None if it may still become one.
+Error first_error(const uint8_t* buf, uint8_t len) {
+  if (len >= 1 && !is_category(buf[0])) return Error::BadCategory;
+  if (len >= 2 && find(buf[0], buf[1]) < 0) return Error::BadDirection;
+  for (uint8_t i = 2; i < len; ++i) {
+    if (buf[i] < '0' || buf[i] > '9') return Error::BadDigit;
+  }
+  if (len == FRAME_LENGTH) {
+    uint32_t value = 0;
+    for (uint8_t i = 2; i < FRAME_LENGTH; ++i) value = value * 10 + (buf[i] - '0');
+    const CommandInfo info = command_info(static_cast<CommandId>(find(buf[0], buf[1])));
+    if (value < info.min || value > info.max) return Error::OutOfRange;
+  }
+  return Error::None;
+}
+
+// The reference: the rules of the spec, written plainly (re-check everything after every slide).
+struct Reference {
+  uint8_t buf[FRAME_LENGTH];
+  uint8_t len = 0;
+  uint32_t last_ms = 0;
+  uint32_t counts[PARSER_ERROR_COUNT + 1] = {};
+  uint8_t frame[FRAME_LENGTH];
+
+  bool feed(uint8_t byte, uint32_t now) {
+    if (len > 0 && now - last_ms > INTER_BYTE_TIMEOUT_MS) {
+      ++counts[static_cast<uint8_t>(Error::Timeout)];
+      len = 0;
+    }
+    last_ms = now;
+    buf[len++] = byte;
+    while (len > 0) {
+      const Error e = first_error(buf, len);
+      if (e == Error::None) {
+        if (len < FRAME_LENGTH) return false;
+        memcpy(frame, buf, FRAME_LENGTH);
+        len = 0;
+        return true;
+      }
+      ++counts[static_cast<uint8_t>(e)];
+      memmove(buf, buf + 1, --len);
+    }
+    return false;
+  }
+};
+
+void check_command(const Command& cmd, const uint8_t* bytes) {
+  CHECK(static_cast<uint8_t>(cmd.id) < COMMAND_COUNT);
+  const CommandInfo info = command_info(cmd.id);
+  CHECK(info.category == cmd.category && info.direction == cmd.direction);
+  CHECK(cmd.value >= info.min && cmd.value <= info.max);
+  CHECK(command_name(cmd.id) != nullptr && strcmp(command_name(cmd.id), "unknown") != 0);
+  uint8_t again[FRAME_LENGTH];
+  CHECK(encode(cmd, again) == Error::None);
+  CHECK(memcmp(again, bytes, FRAME_LENGTH) == 0);
+  Command back{};
+  CHECK(decode(again, back) == Error::None);
+  CHECK(back.id == cmd.id && back.value == cmd.value && back.category == cmd.category &&
+        back.direction == cmd.direction);
+}
+
+void fuzz_stream(const uint8_t* data, size_t size) {
+  StreamParser parser;
+  Reference ref;
+  uint8_t recent[FRAME_LENGTH] = {};  // the last bytes fed, oldest first
+  uint32_t now = 0;
+  for (size_t i = 0; i < size; ++i) {
+    uint8_t byte = data[i];
+    if (byte == 0xFF && i + 1 < size) {
+      ++i;
+      if (data[i] != 0xFF) {
+        now += data[i];
+        continue;
+      }
+    }
+    memmove(recent, recent + 1, FRAME_LENGTH - 1);
+    recent[FRAME_LENGTH - 1] = byte;
+    const bool got = parser.feed(byte, now);
+    const bool expected = ref.feed(byte, now);
+    CHECK(got == expected);
+    CHECK(parser.pending() == ref.len);
+    CHECK(parser.pending() <= FRAME_LENGTH - 1);
+    for (uint8_t e = 1; e <= PARSER_ERROR_COUNT; ++e) {
+      const uint32_t n = ref.counts[e] > 0xFFFF ? 0xFFFF : ref.counts[e];
+      CHECK(parser.error_count(static_cast<Error>(e)) == n);
+    }
+    if (got) {
+      CHECK(parser.pending() == 0);
+      CHECK(memcmp(ref.frame, recent, FRAME_LENGTH) == 0);
+      check_command(parser.command(), recent);
+    }
+  }
+  parser.reset();
+  CHECK(parser.pending() == 0);
+  for (uint8_t e = 1; e <= PARSER_ERROR_COUNT; ++e) CHECK(parser.error_count(static_cast<Error>(e)) == 0);
+}
+
+void fuzz_decode(const uint8_t* data, size_t size) {
+  Command cmd{};
+  const Error whole = decode(data, size, cmd);
+  if (size < FRAME_LENGTH) CHECK(whole == Error::TooShort);
+  if (size > FRAME_LENGTH) CHECK(whole == Error::TooLong);
+  for (size_t at = 0; at + FRAME_LENGTH <= size && at < 64; ++at) {
+    Command out{};
+    const Error e = decode(data + at, out);
+    CHECK(e == first_error(data + at, FRAME_LENGTH));
+    if (e == Error::None) check_command(out, data + at);
+  }
+}
+
+void fuzz_encode(const uint8_t* data, size_t size) {
+  for (size_t at = 0; at + 3 <= size && at < 48; at += 3) {
+    const CommandId id = static_cast<CommandId>(data[at] % COMMAND_COUNT);
+    const uint16_t value = static_cast<uint16_t>(data[at + 1] << 8 | data[at + 2]);
+    const CommandInfo info = command_info(id);
+    uint8_t frame[FRAME_LENGTH];
+    const Error e = encode(id, value, frame);
+    CHECK((e == Error::None) == (value >= info.min && value <= info.max));
+    if (e != Error::None) {
+      CHECK(e == Error::OutOfRange);
+      continue;
+    }
+    Command cmd{};
+    CHECK(decode(frame, cmd) == Error::None);
+    CHECK(cmd.id == id && cmd.value == value);
+    check_command(cmd, frame);
+  }
+  // A CommandId outside the table is refused, not read out of bounds.
+  uint8_t frame[FRAME_LENGTH];
+  CHECK(encode(static_cast<CommandId>(COMMAND_COUNT), 0, frame) != Error::None);
+}
+
+void fuzz_names(const uint8_t* data, size_t size) {
+  if (size == 0) return;
+  const Error e = static_cast<Error>(data[0]);
+  CHECK(error_name(e) != nullptr);
+  const char code = error_code(e);
+  CHECK(code >= 0x21 && code <= 0x7E);
+  char line[64];
+  const uint8_t n = write_rejected(e, line);
+  CHECK(n >= 2 && n <= REPLY_MAX_LENGTH && line[n - 1] == '\n');
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  fuzz_stream(data, size);
+  fuzz_decode(data, size);
+  fuzz_encode(data, size);
+  fuzz_names(data, size);
+  return 0;
+}
