@@ -6,7 +6,6 @@ import difflib
 import hashlib
 import json
 import re
-from collections.abc import Callable
 from pathlib import Path
 from typing import TypeVar
 
@@ -14,7 +13,7 @@ from generator import __version__
 from generator.errors import SpecError, SpecInvalid
 from generator.model import Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
 from generator.names import identifier_problem
-from generator.source import Node, load
+from generator.source import INVALID, Node, load
 
 T = TypeVar("T")
 
@@ -34,7 +33,7 @@ class Reader:
         self.node, self.path, self.errors = node, path, errors
         self.seen: set[str] = set()
         self.ok = isinstance(node.value, dict)
-        if not self.ok:
+        if not self.ok and node.value is not INVALID:
             self.error(node, f"expected a mapping, found {_kind(node.value)}")
 
     def sub(self, key: str) -> str:
@@ -57,6 +56,8 @@ class Reader:
         if node is None:
             return default
         value = node.value
+        if value is INVALID:
+            return default
         if (kind is int and isinstance(value, bool)) or not isinstance(value, kind):
             self.error(node, f"expected {_type_name(kind)}, found {_kind(value)} {value!r}", path=self.sub(key))
             return default
@@ -76,16 +77,20 @@ class Reader:
         value = self.get(key, int, default)
         return value if value is not None else 0
 
-    def mapping(self, key: str, required: bool = True) -> Reader | None:
-        node = self.child(key, required)
-        return Reader(node, self.sub(key), self.errors) if node is not None else None
+    def section(self, key: str) -> Reader:
+        """A required mapping; when it is missing (reported once), a reader that yields defaults silently."""
+        node = self.child(key)
+        if node is None:
+            node = Node(INVALID, self.node.location, self.node.location)
+        return Reader(node, self.sub(key), self.errors)
 
     def entries(self, key: str) -> list[tuple[str, Node]]:
         node = self.child(key)
         if node is None:
             return []
         if not isinstance(node.value, dict):
-            self.error(node, f"expected a mapping, found {_kind(node.value)}", path=self.sub(key))
+            if node.value is not INVALID:
+                self.error(node, f"expected a mapping, found {_kind(node.value)}", path=self.sub(key))
             return []
         if not node.children:
             self.error(node, "must not be empty", path=self.sub(key))
@@ -151,15 +156,12 @@ class _Builder:
         top = Reader(self.root, "", self.errors)
         if not top.ok:
             return None
-        protocol = top.mapping("protocol")
-        frame = top.mapping("frame")
-        link = top.mapping("link")
-        safety = top.mapping("safety")
-        modes = top.mapping("flight_modes")
-        speeds = top.mapping("speeds")
-        if not (protocol and frame and link and safety and modes and speeds):
-            top.finish()
-            return None
+        protocol = top.section("protocol")
+        frame = top.section("frame")
+        link = top.section("link")
+        safety = top.section("safety")
+        modes = top.section("flight_modes")
+        speeds = top.section("speeds")
 
         name = protocol.text("name")
         self._identifier(protocol, "name", name)
@@ -251,7 +253,8 @@ class _Builder:
     def _positive(self, reader: Reader, key: str) -> int:
         value = reader.integer(key)
         node = reader.node.children.get(key) if reader.ok else None
-        if node is not None and isinstance(value, int) and value <= 0:
+        valid = node is not None and isinstance(node.value, int) and not isinstance(node.value, bool)
+        if node is not None and valid and value <= 0:
             reader.error(node, f"{key} must be positive, found {value}", path=reader.sub(key))
         return value
 
@@ -374,13 +377,14 @@ class _Builder:
             description = r.text("description")
             default_field = r.get("field", str, required=False)
             filler_code = r.get("filler", str, required=False)
-            prefix = r.get("command_prefix", str, required=False)
-            if prefix is None:
-                prefix = f"{name}_"
+            prefix: str | None = r.get("command_prefix", str, required=False)
+            if prefix is None and "command_prefix" not in r.node.children:
+                prefix = f"{name}_" if name_ok else None  # unknown: its commands' names can't be checked
             if default_field is not None and default_field not in fields:
                 self._unknown(r, "field", default_field, fields)
             directions = []
-            for dcode, dnode in r.entries("directions"):
+            entries = r.entries("directions")
+            for dcode, dnode in entries:
                 d = self._direction(r, code, dcode, dnode, prefix, default_field, filler_code, fields, channels,
                                     servos)
                 if d is None:
@@ -392,7 +396,7 @@ class _Builder:
                     continue
                 commands[d.command] = f"{code}{dcode}"
                 directions.append(d)
-            if filler_code is not None and len(directions) != 1:
+            if filler_code is not None and len(entries) > 1:
                 r.error(r.node.children["filler"], "a category with a filler byte has exactly one direction",
                         path=r.sub("filler"))
             r.finish()
@@ -414,7 +418,7 @@ class _Builder:
         hint = f"did you mean '{near[0]}'?" if near else "known: " + ", ".join(sorted(known))
         r.error(r.node.children[key], f"unknown {key} '{value}'", hint, r.sub(key))
 
-    def _direction(self, cat: Reader, code: str, dcode: str, node: Node, prefix: str, default_field: str | None,
+    def _direction(self, cat: Reader, code: str, dcode: str, node: Node, prefix: str | None, default_field: str | None,
                    filler_code: str | None, fields: dict[str, tuple[Field, tuple[int, int] | None, int | None, Node]],
                    channels: dict[str, Channel], servos: dict[str, Servo]) -> Direction | None:
         path = f"{cat.path}.directions.{dcode}"
@@ -493,7 +497,7 @@ class _Builder:
             where = default_node if default_node is not None else r.node
             r.error(where, f"default {default} is outside range {pair[0]}..{pair[1]}", path=r.sub("default"))
             return None
-        if not name_ok:
+        if not name_ok or prefix is None:
             return None
         command = f"{prefix}{name}"
         problem = identifier_problem(command)
@@ -567,6 +571,8 @@ class _Builder:
         if node is None:
             return []
         if not isinstance(node.value, list):
+            if node.value is INVALID:
+                return []
             top.error(node, f"expected a list, found {_kind(node.value)}", path="settled")
             return []
         out = []
@@ -581,5 +587,3 @@ class _Builder:
 def _is_code(code: str) -> bool:
     return len(code) == 1 and 0x21 <= ord(code) <= 0x7E
 
-
-Check = Callable[[Spec], None]

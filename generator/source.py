@@ -14,7 +14,17 @@ import yaml
 
 from generator.errors import Location, SpecError
 
-Plain = None | bool | int | float | str | list["Plain"] | dict[str, "Plain"]
+
+class Invalid:
+    """The value of a node whose error was already reported: readers skip it without a second error."""
+
+    def __repr__(self) -> str:
+        return "<invalid>"
+
+
+INVALID = Invalid()
+
+Plain = None | bool | int | float | str | list["Plain"] | dict[str, "Plain"] | Invalid
 
 
 @dataclass
@@ -54,6 +64,9 @@ def _convert(
     loader: yaml.SafeLoader, ynode: yaml.Node, file: str, path: str, key_loc: Location, errors: list[SpecError]
 ) -> Node:
     loc = _location(file, ynode.start_mark)
+    if ynode.tag not in _PLAIN_TAGS:
+        errors.append(SpecError(loc, path, f"unsupported YAML tag {ynode.tag}"))
+        return Node(INVALID, loc, key_loc)
     if isinstance(ynode, yaml.MappingNode):
         children: dict[str, Node] = {}
         for key_node, value_node in ynode.value:
@@ -75,9 +88,6 @@ def _convert(
             for i, item in enumerate(ynode.value)
         ]
         return Node([i.value for i in items], loc, key_loc, items=items)
-    if ynode.tag not in _PLAIN_TAGS:
-        errors.append(SpecError(loc, path, f"unsupported YAML tag {ynode.tag}"))
-        return Node(None, loc, key_loc)
     value = loader.construct_object(ynode, deep=True)
     return Node(value, loc, key_loc)
 
@@ -88,4 +98,6 @@ _PLAIN_TAGS = {
     "tag:yaml.org,2002:int",
     "tag:yaml.org,2002:float",
     "tag:yaml.org,2002:str",
+    "tag:yaml.org,2002:map",
+    "tag:yaml.org,2002:seq",
 }
