@@ -48,6 +48,9 @@ class FlightResult:
     wall_seconds: float
     frames_sent: int
     reconnects: int
+    final_laser: bool  # the virtual drone's laser pin at the end
+    final_armed: bool
+    final_altitude: float
     record_dir: str | None = None
     path_picture: str | None = None
     video: str | None = None
@@ -72,6 +75,7 @@ class FlightJob:
     noise: bool = True
     width: int = 320
     height: int = 240
+    executable: str | None = None
 
 
 def fly(
@@ -178,6 +182,9 @@ def fly(
                 wall_seconds=time.perf_counter() - wall0,
                 frames_sent=len(link.sent),
                 reconnects=link.reconnects,
+                final_laser=world.outputs.laser,
+                final_armed=world.outputs.armed,
+                final_altitude=state.z,
                 record_dir=str(recorder.dir) if recorder is not None else None,
                 path_picture=picture,
                 video=str(recorder.video_path) if recorder is not None else None,
@@ -196,6 +203,7 @@ def _fly_job(job: FlightJob) -> FlightResult:
         max_seconds=job.max_seconds,
         noise=job.noise,
         camera=CameraModel(job.width, job.height),
+        executable=job.executable,
     )
 
 

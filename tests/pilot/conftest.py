@@ -1,0 +1,35 @@
+"""Fixtures of the pilot tests: the real virtual drone, built from the firmware sources for this run."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="session")
+def virtual_drone(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The firmware's host build (``make firmware-host``) in a directory of this test run, so that no
+    other build in the work tree can change or remove it underneath the tests. ``PILOT_VIRTUAL_DRONE``
+    names a prebuilt one instead."""
+    prebuilt = os.environ.get("PILOT_VIRTUAL_DRONE")
+    if prebuilt:
+        path = Path(prebuilt)
+        assert path.is_file(), f"PILOT_VIRTUAL_DRONE={prebuilt} does not exist"
+        return path
+    build = tmp_path_factory.mktemp("firmware-build")
+    proc = subprocess.run(
+        ["make", "-s", "firmware-host", f"FW_BUILD={build}"],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert proc.returncode == 0, f"make firmware-host failed:\n{proc.stdout}\n{proc.stderr}"
+    exe = build / "host" / "virtual_drone"
+    assert exe.is_file(), f"make firmware-host did not produce {exe}"
+    return exe
