@@ -1,5 +1,14 @@
 #include "drone_logic.h"
 
+// Bench builds (-DDRONE_BENCH_PARSER_PIN=n) time the parser alone: the app
+// supplies this hook, which toggles a spare pin around StreamParser::feed().
+#ifdef DRONE_BENCH_PARSER_PIN
+void drone_bench_parser_mark();
+#define DRONE_PARSER_MARK() drone_bench_parser_mark()
+#else
+#define DRONE_PARSER_MARK()
+#endif
+
 namespace drone {
 
 namespace {
@@ -87,7 +96,10 @@ void Drone::reply(const char* line, uint8_t length) {
 void Drone::receive(uint8_t byte, uint32_t now_ms) {
   now_ms_ = now_ms;
   char line[dp::REPLY_MAX_LENGTH];
-  if (parser_.feed(byte, now_ms)) {
+  DRONE_PARSER_MARK();
+  const bool complete = parser_.feed(byte, now_ms);
+  DRONE_PARSER_MARK();
+  if (complete) {
     execute(parser_.command(), now_ms);
   } else if (parser_.last_error() != dp::Error::None) {
     // A malformed or timed-out frame: tell the Pi, change nothing else. It

@@ -43,7 +43,11 @@ void build(const uint16_t width_us[pulse::OUTPUTS], pulse::Schedule& s) {
 // spins on TCNT1 until the edge's exact tick. Other interrupts (the UART's,
 // millis') that delay our entry are thus absorbed as long as they are shorter
 // than the lead, instead of showing up as pulse jitter. Cost: about 1 % CPU.
-constexpr uint16_t EARLY_TICKS = 40 * pulse::TICKS_PER_US;
+// (DRONE_PULSE_LEAD_US=0 builds the plain scheme, for the jitter benchmark.)
+#ifndef DRONE_PULSE_LEAD_US
+#define DRONE_PULSE_LEAD_US 40
+#endif
+constexpr uint16_t EARLY_TICKS = DRONE_PULSE_LEAD_US * pulse::TICKS_PER_US;
 static_assert(EARLY_TICKS < 500 * pulse::TICKS_PER_US, "the lead must stay shorter than the shortest slot");
 uint16_t edge_at;  // TCNT1 value of the next edge
 

@@ -14,6 +14,11 @@
  *   {"ev":"level","pin":P,"t":C,"v":0|1}         every level change (laser pin only)
  *   {"ev":"tx","t":C,"text":"..."}                a line the firmware sent
  *   {"ev":"end","t":C,"unsent":N}                 N = script bytes never taken
+ *
+ * --paint ADDR fills the RAM from ADDR (the end of .bss, __heap_start) to
+ * RAMEND with a pattern before the run, and reports at the end how far the
+ * heap grew up and the stack grew down into it:
+ *   {"ev":"ram","heap_start":A,"heap_top":A,"stack_low":A,"ramend":A}
  */
 #include <stdint.h>
 #include <stdio.h>
@@ -146,9 +151,10 @@ static int by_time(const void *a, const void *b) {
 }
 
 static void read_script(FILE *f) {
-  char line[8192];
+  char *line = NULL;
+  size_t line_cap = 0;
   size_t cap = 0;
-  while (fgets(line, sizeof line, f)) {
+  while (getline(&line, &line_cap, f) > 0) {
     char *p = line;
     while (*p == ' ') ++p;
     if (*p == '#' || *p == '\n' || *p == 0) continue;
@@ -178,17 +184,20 @@ static void read_script(FILE *f) {
       p += 2;
     }
   }
+  free(line);
   qsort(events, event_count, sizeof *events, by_time);
 }
 
 int main(int argc, char **argv) {
   const char *elf = NULL, *mcu = "atmega328p", *script = NULL;
+  long paint = -1;
   double until_ms = -1;
   for (int i = 1; i < argc; ++i) {
     if (!strcmp(argv[i], "--elf") && i + 1 < argc) elf = argv[++i];
     else if (!strcmp(argv[i], "--mcu") && i + 1 < argc) mcu = argv[++i];
     else if (!strcmp(argv[i], "--until") && i + 1 < argc) until_ms = atof(argv[++i]);
     else if (!strcmp(argv[i], "--script") && i + 1 < argc) script = argv[++i];
+    else if (!strcmp(argv[i], "--paint") && i + 1 < argc) paint = strtol(argv[++i], NULL, 0);
     else {
       fprintf(stderr, "usage: drone_sim --elf FILE [--mcu atmega328p|atmega2560] --until MS [--script FILE]\n");
       return 2;
@@ -239,11 +248,25 @@ int main(int argc, char **argv) {
     avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(map[i].port), map[i].bit), pin_changed,
                             &watches[i]);
   }
+  const uint8_t PAINT = 0xA5;
+  if (paint >= 0)
+    for (long a = paint; a <= avr->ramend; ++a) avr->data[a] = PAINT;
   if (event_count) avr_cycle_timer_register(avr, events[0].when > avr->cycle ? events[0].when - avr->cycle : 1, inject, NULL);
 
   const avr_cycle_count_t end = (avr_cycle_count_t)(until_ms * 16000.0);
   int state = cpu_Running;
   while (avr->cycle < end && state != cpu_Done && state != cpu_Crashed) state = avr_run(avr);
+  if (paint >= 0) {
+    long heap_top = paint, stack_low = avr->ramend;
+    while (heap_top <= avr->ramend && avr->data[heap_top] != PAINT) ++heap_top;
+    /* The stack's deepest point: the lowest byte that is not paint, searching
+     * down from the top through the untouched gap above the heap. */
+    long a = heap_top;
+    while (a <= avr->ramend && avr->data[a] == PAINT) ++a;
+    stack_low = a;
+    printf("{\"ev\":\"ram\",\"heap_start\":%ld,\"heap_top\":%ld,\"stack_low\":%ld,\"ramend\":%d}\n", paint, heap_top,
+           stack_low, avr->ramend);
+  }
   size_t unsent = pending_tail - pending_head;
   for (size_t i = event_next; i < event_count; ++i) unsent += events[i].length;
   printf("{\"ev\":\"end\",\"t\":%llu,\"unsent\":%zu,\"state\":%d}\n", (unsigned long long)avr->cycle, unsent,
