@@ -92,8 +92,8 @@ class Tick:
     state: State
     command: bytes | None
     replies: tuple[dp.Reply, ...]
-    frame_t: float  # when the frame arrived (the pacer's clock)
-    sent_t: float | None  # when its command's last byte was written (the wall clock), if any
+    frame_t: float  # when the frame arrived (the wall clock)
+    sent_t: float | None  # when its command's last byte was written and flushed (the wall clock), if any
 
 
 class Observer(Protocol):
@@ -114,31 +114,37 @@ class RunResult:
 class StatusLine:
     """One line on a terminal, rewritten: state, target seen, command rate, time, last command."""
 
-    def __init__(self, out: TextIO = sys.stderr, every_s: float = 0.25) -> None:
+    def __init__(self, out: TextIO = sys.stderr, every_s: float = 0.25, live: bool | None = None) -> None:
         self.out = out
         self.every_s = every_s
+        # on a terminal the line is rewritten in place; elsewhere (a log, make) one line per state change
+        self.live = out.isatty() if live is None else live
         self._last = -math.inf
+        self._state: State | None = None
         self._sends: deque[float] = deque()
 
     def on_tick(self, tick: Tick) -> None:
         if tick.command is not None:
             self._sends.append(tick.t)
-        while self._sends and self._sends[0] < tick.t - 1.0:
+        while self._sends and self._sends[0] <= tick.t - 1.0:
             self._sends.popleft()
-        if tick.t - self._last < self.every_s:
+        changed = tick.state is not self._state
+        self._state = tick.state
+        if self.live and tick.t - self._last < self.every_s and not changed:
+            return
+        if not self.live and not changed:
             return
         self._last = tick.t
         seen = "yes" if tick.detection is not None and tick.detection.found else "no "
         last = tick.command.decode("ascii") if tick.command else "      "
-        self.out.write(
-            f"\rt {tick.t:7.2f}s  state {tick.state.value:8s}  target {seen}  "
-            f"{len(self._sends):3d} cmd/s  last {last}"
-        )
+        line = f"t {tick.t:7.2f}s  state {tick.state.value:8s}  target {seen}  {len(self._sends):3d} cmd/s  last {last}"
+        self.out.write(f"\r{line}" if self.live else f"{line}\n")
         self.out.flush()
 
     def finish(self) -> None:
-        self.out.write("\n")
-        self.out.flush()
+        if self.live:
+            self.out.write("\n")
+            self.out.flush()
 
 
 def run(
@@ -166,8 +172,8 @@ def run(
             if now - start >= max_seconds:
                 reason = f"time limit ({max_seconds:g} s)"
                 break
-            frame_wall = wall_clock()
             frame = source.read()
+            frame_wall = wall_clock()  # the frame has arrived
             if frame is None:
                 reason = "end of frames"
                 break
