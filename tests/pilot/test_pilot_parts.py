@@ -1,0 +1,279 @@
+"""Config, calibration, frame sources, the kinematic model and the renderer."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import cv2
+import drone_protocol as dp
+import numpy as np
+import pilot_synth as synth
+import pytest
+import yaml
+
+from pilot import config as config_mod
+from pilot.calibrate import calibrate_to_config, hsv_ranges_from_sample
+from pilot.config import HsvConfig, PilotConfig
+from pilot.detect import HsvBlobDetector
+from pilot.errors import ConfigError, FrameSourceError
+from pilot.sim.camera import CameraModel, CameraPose, Renderer
+from pilot.sim.model import DroneModel, Outputs, StickCentres
+from pilot.sim.room import SCENARIOS, Room, make_scenario
+from pilot.sources import CameraSource, ImageFolderSource, VideoFileSource
+
+# -- config --------------------------------------------------------------------------------------------
+
+
+def test_config_round_trip(tmp_path: Path) -> None:
+    cfg = dataclasses.replace(
+        PilotConfig(), detector="aruco", controller=dataclasses.replace(PilotConfig().controller, fire_ms=900)
+    )
+    path = tmp_path / "pilot.yaml"
+    config_mod.save(cfg, path)
+    assert config_mod.load(path) == cfg
+
+
+@pytest.mark.parametrize(
+    "text,needle",
+    [
+        ("controller:\n  fire_msec: 10\n", "unknown option 'controller.fire_msec'"),
+        ("controller:\n  fire_ms: soon\n", "option 'controller.fire_ms' must be an integer"),
+        ("detector: sonar\n", "option 'detector' must be one of"),
+        ("hsv:\n  ranges: [[[0, 0, 0], [200, 255, 255]]]\n", "option 'hsv.ranges[0]'"),
+        ("hsv:\n  ranges: [[[0, 0], [10, 255, 255]]]\n", "option 'hsv.ranges[0][0]' must have 3 items"),
+        ("controller:\n  retreat_size: 0.5\n", "option 'controller.retreat_size'"),
+        ("link: 5\n", "option 'link' must be a mapping"),
+        ("- a\n- b\n", "the top level must be a mapping"),
+    ],
+)
+def test_config_errors_name_the_option_and_the_file(tmp_path: Path, text: str, needle: str) -> None:
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as info:
+        config_mod.load(path)
+    assert needle in str(info.value)
+    assert str(path) in str(info.value)
+
+
+def test_missing_config_file_is_a_config_error(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match="cannot read config"):
+        config_mod.load(tmp_path / "nope.yaml")
+
+
+# -- calibration ----------------------------------------------------------------------------------------
+
+
+def test_calibration_of_red_gives_two_ranges_that_find_the_target(tmp_path: Path) -> None:
+    bg = synth.background(320, 240)
+    img = bg.copy()
+    cv2.circle(img, (160, 120), 40, (40, 20, 200), -1)  # a red whose pixels straddle hue 0 with noise
+    img = synth.degrade(img, 1.0, 6.0, seed=1)
+    ranges = hsv_ranges_from_sample(img)
+    assert len(ranges) == 2
+    assert ranges[0][0][0] == 0 and ranges[1][1][0] == 179
+    det = HsvBlobDetector(HsvConfig(ranges=ranges))
+    moved = synth.degrade(synth.red_disc(bg, 80, 60, 20), 1.0, 0.0, 0)
+    d = det.detect(moved)
+    assert d.found and abs(d.cx - 80) <= 1.5 and abs(d.cy - 60) <= 1.5
+    assert not det.detect(synth.background(320, 240)).found
+
+
+def test_calibration_of_blue_gives_one_range_and_is_saved(tmp_path: Path) -> None:
+    img = synth.background(320, 240)
+    cv2.circle(img, (100, 100), 30, (200, 80, 30), -1)
+    image_path = tmp_path / "blue.png"
+    cv2.imwrite(str(image_path), img)
+    cfg_path = tmp_path / "pilot.yaml"
+    cfg_path.write_text(yaml.safe_dump({"controller": {"fire_ms": 700}}))
+    cfg = calibrate_to_config(image_path, cfg_path, roi=(85, 85, 30, 30))
+    assert len(cfg.hsv.ranges) == 1
+    (lo, hi) = cfg.hsv.ranges[0]
+    hue = int(cv2.cvtColor(np.array([[[200, 80, 30]]], np.uint8), cv2.COLOR_BGR2HSV)[0, 0, 0])
+    assert lo[0] <= hue <= hi[0]
+    reloaded = config_mod.load(cfg_path)
+    assert reloaded.hsv.ranges == cfg.hsv.ranges
+    assert reloaded.controller.fire_ms == 700  # the rest of the file is kept
+    assert HsvBlobDetector(reloaded.hsv).detect(img).found
+
+
+def test_calibration_roi_outside_the_image() -> None:
+    with pytest.raises(ConfigError, match="not inside"):
+        hsv_ranges_from_sample(synth.background(320, 240), roi=(300, 200, 50, 50))
+
+
+# -- frame sources -------------------------------------------------------------------------------------
+
+
+def write_video(path: Path, n: int) -> None:
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"MJPG"), 20.0, (160, 120))
+    for i in range(n):
+        img = np.full((120, 160, 3), 100, np.uint8)
+        cv2.circle(img, (20 + 5 * i, 60), 10, synth.RED, -1)
+        writer.write(img)
+    writer.release()
+
+
+def test_video_source_in_order_then_none(tmp_path: Path) -> None:
+    path = tmp_path / "v.avi"
+    write_video(path, 10)
+    det = HsvBlobDetector()
+    xs = []
+    with VideoFileSource(path, time_fn=lambda: 1.5) as src:
+        while (frame := src.read()) is not None:
+            assert frame.t == 1.5
+            xs.append(det.detect(frame.image).cx)
+        assert src.read() is None
+    assert len(xs) == 10
+    assert all(abs(x - (20 + 5 * i)) <= 2 for i, x in enumerate(xs))
+
+
+def test_image_folder_source_sorted(tmp_path: Path) -> None:
+    for i in (3, 1, 2):
+        img = np.full((60, 80, 3), 100, np.uint8)
+        cv2.circle(img, (10 * i, 30), 6, synth.RED, -1)
+        cv2.imwrite(str(tmp_path / f"frame{i}.png"), img)
+    (tmp_path / "notes.txt").write_text("not an image")
+    with ImageFolderSource(tmp_path) as src:
+        frames = [src.read() for _ in range(4)]
+    assert frames[3] is None
+    got = [HsvBlobDetector(HsvConfig(min_area=10)).detect(f.image).cx for f in frames[:3] if f is not None]
+    assert [round(x) for x in got] == [10, 20, 30]
+    assert [f.index for f in frames[:3] if f is not None] == [0, 1, 2]
+
+
+def test_source_errors(tmp_path: Path) -> None:
+    with pytest.raises(FrameSourceError, match="no such file"):
+        VideoFileSource(tmp_path / "missing.avi")
+    with pytest.raises(FrameSourceError, match="not a directory"):
+        ImageFolderSource(tmp_path / "missing")
+    with pytest.raises(FrameSourceError, match="holds no images"):
+        ImageFolderSource(tmp_path)
+    with pytest.raises(FrameSourceError, match="cannot open"):
+        CameraSource(str(tmp_path / "no-such-camera"))
+
+
+def test_camera_source_reports_a_lost_camera(tmp_path: Path) -> None:
+    """A capture that stops delivering frames (here: a short recording opened as the camera device)."""
+    path = tmp_path / "cam.avi"
+    write_video(path, 3)
+    src = CameraSource(str(path), max_failures=3)
+    got = [src.read() for _ in range(3)]
+    assert all(f is not None for f in got)
+    with pytest.raises(FrameSourceError, match="lost"):
+        src.read()
+    src.close()
+    src.close()
+
+
+# -- the kinematic model -------------------------------------------------------------------------------
+
+
+def neutral(**kw: int | bool) -> Outputs:
+    ch = dp.CHANNELS
+    base = {
+        "roll": ch["roll"].median,
+        "pitch": ch["pitch"].median,
+        "throttle": ch["throttle"].median,
+        "yaw": ch["yaw"].median,
+        "armed": True,
+    }
+    base.update(kw)
+    return Outputs(**base)  # type: ignore[arg-type]
+
+
+def airborne_model(heading: float = 0.0) -> DroneModel:
+    m = DroneModel(Room(), (5.0, 4.0, heading), StickCentres.from_protocol())
+    m.state.z = 1.0
+    return m
+
+
+def run_model(m: DroneModel, out: Outputs, seconds: float) -> None:
+    for _ in range(round(seconds / 0.01)):
+        m.step(out, 0.01)
+
+
+def test_model_sticks_follow_the_seed_tables() -> None:
+    ch = dp.CHANNELS
+    m = airborne_model(heading=0.0)
+    run_model(m, neutral(pitch=ch["pitch"].high), 1.0)  # forward: +x for heading 0
+    assert m.state.x > 5.3 and abs(m.state.y - 4.0) < 0.01
+    m = airborne_model(heading=0.0)
+    run_model(m, neutral(roll=ch["roll"].high), 1.0)  # right: -y for heading 0
+    assert m.state.y < 3.7 and abs(m.state.x - 5.0) < 0.01
+    m = airborne_model()
+    run_model(m, neutral(yaw=ch["yaw"].high), 1.0)  # turn right: clockwise, heading decreases
+    assert -math.radians(70) < m.state.heading < -math.radians(30)
+    m = airborne_model()
+    run_model(m, neutral(throttle=ch["throttle"].high), 1.0)
+    assert m.state.z > 1.3
+    m = airborne_model()
+    run_model(m, neutral(pitch=ch["pitch"].median + 10, yaw=ch["yaw"].median - 10), 1.0)  # dead band
+    assert (m.state.x, m.state.y, m.state.heading) == (5.0, 4.0, 0.0)
+
+
+def test_model_walls_failsafe_and_disarm() -> None:
+    ch = dp.CHANNELS
+    m = airborne_model(heading=0.0)
+    run_model(m, neutral(pitch=ch["pitch"].maximum), 10.0)  # full forward into the +x wall
+    assert m.state.wall_hits == 1 and m.state.x == pytest.approx(Room().width - m.p.radius)
+    m = airborne_model()
+    run_model(m, neutral(throttle=dp.FAILSAFE_THROTTLE_US), 3.0)
+    assert m.state.z == 0.0 and m.state.crashes == 0  # the failsafe lands it
+    m = airborne_model()
+    run_model(m, neutral(armed=False), 2.0)
+    assert m.state.z == 0.0 and m.state.crashes == 1  # motors off in the air
+    m = DroneModel(Room(), (5.0, 4.0, 0.0), StickCentres.from_protocol())
+    run_model(m, neutral(pitch=ch["pitch"].high, yaw=ch["yaw"].high), 1.0)  # on the ground: no sliding
+    assert (m.state.x, m.state.y, m.state.z) == (5.0, 4.0, 0.0)
+
+
+# -- the renderer -----------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_scenarios_are_deterministic_and_inside_the_room(name: str) -> None:
+    for seed in range(20):
+        a, b = make_scenario(name, seed), make_scenario(name, seed)
+        assert a == b
+        tx, ty, tz = a.target.position
+        assert a.room.inside(tx, ty, 1.0) and 0.0 < tz < a.room.height
+        assert a.room.inside(a.start[0], a.start[1], 1.0)
+        for ball in a.distractors:
+            assert a.room.inside(ball.position[0], ball.position[1], 0.5)
+    assert make_scenario(name, 1) != make_scenario(name, 2)
+
+
+def test_render_is_deterministic_and_detects_where_it_projects() -> None:
+    sc = make_scenario("distractor", 4)
+    cam = CameraModel(320, 240)
+    x, y, _ = sc.start
+    tx, ty, _tz = sc.target.position
+    heading = math.atan2(ty - y, tx - x) + math.radians(8)
+    pose = CameraPose.from_drone(x, y, 1.2, heading, 90.0, 90.0)
+    a = Renderer(sc, cam).render(pose, 1.0)
+    b = Renderer(sc, cam).render(pose, 1.0)
+    assert np.array_equal(a, b)
+    projected = Renderer(sc, cam).project_point(pose, sc.target.position)
+    assert projected is not None
+    d = HsvBlobDetector().detect(a)
+    assert d.found
+    assert abs(d.cx - projected[0]) <= 1.5 and abs(d.cy - projected[1]) <= 1.5
+    expected = 2 * cam.focal * sc.target.radius / projected[2]
+    assert abs(d.size - expected) <= 2.5
+
+
+def test_render_tilt_moves_the_horizon_and_hidden_hides_the_target() -> None:
+    sc = make_scenario("hidden", 0, noise=False)
+    r = Renderer(sc, CameraModel(320, 240))
+    x, y, _ = sc.start
+    tx, ty, _ = sc.target.position
+    heading = math.atan2(ty - y, tx - x)
+    level = r.render(CameraPose.from_drone(x, y, 1.2, heading, 90, 90), 0.0)
+    up = r.render(CameraPose.from_drone(x, y, 1.2, heading, 90, 110), 0.0)
+    det = HsvBlobDetector()
+    d_level, d_up = det.detect(level), det.detect(up)
+    assert d_level.found and d_up.found and d_up.cy > d_level.cy + 50  # looking up: the target drops
+    during = r.render(CameraPose.from_drone(x, y, 1.2, heading, 90, 90), sc.hidden[0].start + 0.1)
+    assert not det.detect(during).found
