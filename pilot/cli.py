@@ -229,7 +229,8 @@ def _fly_real(args: argparse.Namespace, cfg: PilotConfig) -> int:
         return EXIT_INTERRUPTED
     if result.error is not None and not isinstance(result.error, PilotError):
         print(f"pilot: stopped by {type(result.error).__name__}: {result.error}", file=sys.stderr)
-    return EXIT_OK if result.state is State.DONE and result.error is None else EXIT_FAILED
+    done = result.state is State.DONE and result.error is None and result.fired
+    return EXIT_OK if done else EXIT_FAILED
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -69,8 +69,8 @@ class RealPacer:
 class DryRunSink:
     """``--dry-run``: decide and print the commands, send nothing."""
 
-    def __init__(self, out: TextIO = sys.stdout, clock: Callable[[], float] = time.monotonic) -> None:
-        self.out = out
+    def __init__(self, out: TextIO | None = None, clock: Callable[[], float] = time.monotonic) -> None:
+        self.out = out if out is not None else sys.stdout
         self.sent: list[bytes] = []
         self._clock = clock
 
@@ -114,8 +114,8 @@ class RunResult:
 class StatusLine:
     """One line on a terminal, rewritten: state, target seen, command rate, time, last command."""
 
-    def __init__(self, out: TextIO = sys.stderr, every_s: float = 0.25, live: bool | None = None) -> None:
-        self.out = out
+    def __init__(self, out: TextIO | None = None, every_s: float = 0.25, live: bool | None = None) -> None:
+        self.out = out = out if out is not None else sys.stderr
         self.every_s = every_s
         # on a terminal the line is rewritten in place; elsewhere (a log, make) one line per state change
         self.live = out.isatty() if live is None else live
