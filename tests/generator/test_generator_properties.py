@@ -94,13 +94,13 @@ def test_decode_then_encode_is_the_identity_and_errors_point_at_the_first_bad_by
     except p.ProtocolError as exc:
         kind, pos = exc.kind, exc.position
         assert kind is not None
-        table = {s.direction.value: s for s in SPECS if ord(s.category.value) == frame[0]}
+        table = {s.direction.value: s for s in SPECS if ord(s.category.value) == frame[0]}  # bytes.isdigit: ASCII
         if kind is p.ErrorKind.BAD_CATEGORY:
             assert pos == 0 and not table
         elif kind is p.ErrorKind.BAD_DIRECTION:
             assert pos == 1 and table and chr(frame[1]) not in table
         elif kind is p.ErrorKind.BAD_DIGIT:
-            assert 2 <= pos <= 5 and not chr(frame[pos]).isdigit() and (pos == 2 or frame[2:pos].isdigit())
+            assert 2 <= pos <= 5 and not frame[pos:pos + 1].isdigit() and (pos == 2 or frame[2:pos].isdigit())
         else:
             assert kind is p.ErrorKind.OUT_OF_RANGE and pos == 2 and frame[2:].isdigit()
             spec = table[chr(frame[1])]
