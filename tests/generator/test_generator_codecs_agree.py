@@ -122,3 +122,21 @@ def test_python_and_cpp_agree_on_every_length() -> None:
     frames = [good[:n] for n in range(7)] + [good + b"0", good * 2, b"", rng.randbytes(40)]
     frames += [rng.randbytes(rng.randrange(12)) for _ in range(2000)]
     assert [python_result(f) for f in frames] == cpp_results(frames)
+
+
+def test_both_ends_write_and_read_the_same_reply_lines() -> None:
+    """The Arduino's reply encoders print exactly what the Python reply functions print and parse_reply reads."""
+    lines = [bytes.fromhex(line) for line in h.run_driver("replies", "")]
+    commands = [p.decode(p.encode(s.category, s.direction, s.minimum)) for s in p.COMMANDS.values()]
+    expected = [p.ready_line(), *(p.accepted_line(c) for c in commands), *(p.rejected_line(k) for k in p.ErrorKind),
+                p.failsafe_line()]
+    assert lines == expected
+    ready = p.parse_reply(lines[0])
+    assert (ready.kind, ready.protocol, ready.fingerprint) == (p.ReplyKind.READY, p.PROTOCOL_NAME, p.SPEC_FINGERPRINT)
+    for line, cmd in zip(lines[1:1 + len(commands)], commands, strict=True):
+        reply = p.parse_reply(line)
+        assert (reply.kind, reply.category, reply.direction) == (p.ReplyKind.ACCEPTED, cmd.category,
+                                                                 cmd.direction.value)
+    for line, kind in zip(lines[1 + len(commands):-1], p.ErrorKind, strict=True):
+        assert p.parse_reply(line).error is kind
+    assert p.parse_reply(lines[-1]).kind is p.ReplyKind.FAILSAFE

@@ -6,6 +6,8 @@
 //                            "mark" (echoed, to locate frames in the output)
 //                            stdout: "frame <hex>" for every frame the StreamParser emits (re-encoded), then
 //                            "pending <n>" and one "count <error name> <n>" per parser error kind
+//   protocol_driver replies  stdout: the ready line, the accepted line of every command (at its minimum), the
+//                            rejected line of every error kind, and the failsafe line, each as hex
 //
 // Every result is also checked here: a decoded command re-encodes to the same bytes, lies in its command's
 // range and matches its CommandInfo; the parser never holds a full frame. A failed check exits 3.
@@ -104,7 +106,27 @@ static int run_stream() {
   return 0;
 }
 
+static void print_line(const char* line, uint8_t n) {
+  if (n == 0 || n > REPLY_MAX_LENGTH || line[n - 1] != '\n') fail("reply line without its newline", line);
+  for (uint8_t i = 0; i < n; ++i) printf("%02x", static_cast<unsigned>(static_cast<uint8_t>(line[i])));
+  printf("\n");
+}
+
+static int run_replies() {
+  char line[REPLY_MAX_LENGTH + 8];
+  print_line(line, write_ready(line));
+  for (uint8_t i = 0; i < COMMAND_COUNT; ++i) {
+    const CommandInfo info = command_info(static_cast<CommandId>(i));
+    const Command cmd{static_cast<CommandId>(i), info.category, info.direction, info.min};
+    print_line(line, write_accepted(cmd, line));
+  }
+  for (uint8_t e = 1; e <= static_cast<uint8_t>(Error::Busy); ++e) print_line(line, write_rejected(static_cast<Error>(e), line));
+  print_line(line, write_failsafe(line));
+  return 0;
+}
+
 int main(int argc, char** argv) {
+  if (argc == 2 && strcmp(argv[1], "replies") == 0) return run_replies();
   if (argc == 2 && strcmp(argv[1], "decode") == 0) return run_decode();
   if (argc == 2 && strcmp(argv[1], "stream") == 0) return run_stream();
   fprintf(stderr, "usage: %s decode|stream\n", argv[0]);
