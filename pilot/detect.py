@@ -13,6 +13,7 @@ from typing import Protocol
 
 import cv2
 import numpy as np
+import numpy.typing as npt
 from cv2.typing import MatLike
 
 from pilot.config import ArucoConfig, HsvConfig, PilotConfig
@@ -66,16 +67,35 @@ class HsvBlobDetector:
         self._ranges = [
             (np.array(lo, dtype=np.uint8), np.array(hi, dtype=np.uint8)) for lo, hi in cfg.ranges
         ]
+        # Fast path when every range shares its saturation/value bounds (red's two ranges do): one
+        # inRange on S and V, and the hue ranges as a 256-entry lookup table on the hue channel,
+        # instead of one 3-channel inRange per hue range.
+        sv = {(lo[1:], hi[1:]) for lo, hi in cfg.ranges}
+        self._sv: tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]] | None = None
+        self._hue_lut: npt.NDArray[np.uint8] | None = None
+        if len(cfg.ranges) > 1 and len(sv) == 1:
+            (s_lo, s_hi), = sv
+            self._sv = (np.array((0, *s_lo), np.uint8), np.array((255, *s_hi), np.uint8))
+            lut = np.zeros(256, np.uint8)
+            for lo, hi in cfg.ranges:
+                lut[lo[0] : hi[0] + 1] = 255
+            self._hue_lut = lut
         self.min_area = cfg.min_area
         k = max(1, cfg.open_kernel)
         self._kernel = cv2.getStructuringElement(cv2.MORPH_RECT, (k, k)) if k > 1 else None
 
     def mask(self, image: MatLike) -> MatLike:
         hsv = cv2.cvtColor(image, cv2.COLOR_BGR2HSV)
-        lo, hi = self._ranges[0]
-        mask = cv2.inRange(hsv, lo, hi)
-        for lo, hi in self._ranges[1:]:
-            mask = cv2.bitwise_or(mask, cv2.inRange(hsv, lo, hi))
+        if self._sv is not None and self._hue_lut is not None:
+            mask = cv2.bitwise_and(
+                cv2.inRange(hsv, self._sv[0], self._sv[1]),
+                cv2.LUT(cv2.extractChannel(hsv, 0), self._hue_lut),
+            )
+        else:
+            lo, hi = self._ranges[0]
+            mask = cv2.inRange(hsv, lo, hi)
+            for lo, hi in self._ranges[1:]:
+                mask = cv2.bitwise_or(mask, cv2.inRange(hsv, lo, hi))
         if self._kernel is not None:
             mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, self._kernel)
         return mask

@@ -116,3 +116,23 @@ def test_aruco_ignores_other_ids_and_distractors() -> None:
     assert ArucoMarkerDetector(ArucoConfig(marker_id=-1)).detect(other).found
     red_only = synth.red_disc(bg, 160, 120, 30)
     assert not det.detect(red_only).found
+
+
+def test_lookup_table_path_equals_one_inrange_per_range() -> None:
+    """The fast path (shared S/V bounds, hue by lookup table) gives exactly the mask of one inRange per range."""
+    import numpy as np
+
+    cfg = HsvConfig()
+    fast = HsvBlobDetector(cfg)
+    assert fast._hue_lut is not None
+    rng = np.random.default_rng(5)
+    for _ in range(5):
+        img = rng.integers(0, 256, (120, 160, 3), dtype=np.uint8)
+        hsv = cv2.cvtColor(img, cv2.COLOR_BGR2HSV)
+        reference = np.zeros(hsv.shape[:2], np.uint8)
+        for lo, hi in cfg.ranges:
+            reference |= cv2.inRange(hsv, np.array(lo, np.uint8), np.array(hi, np.uint8))
+        reference = cv2.morphologyEx(reference, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_RECT, (3, 3)))
+        assert np.array_equal(fast.mask(img), reference)
+    general = HsvBlobDetector(HsvConfig(ranges=(((0, 120, 70), (8, 255, 255)), ((172, 100, 70), (179, 255, 255)))))
+    assert general._hue_lut is None
