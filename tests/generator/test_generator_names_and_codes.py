@@ -17,14 +17,14 @@ ARM = "      a:\n        name: arm"
 READY = 'prefix: "#READY"'
 
 
-def generate_or_reject(tmp_path: Path, text: str, located_at: str) -> Path | None:
-    """Generate `text`; None if it was rejected with an error located at `located_at` (a spec path)."""
+def generate_or_reject(tmp_path: Path, text: str, *located_at: str) -> Path | None:
+    """Generate `text`; None if it was rejected with an error located at one of `located_at` (spec paths)."""
     spec = tmp_path / "drone.yaml"
     spec.write_text(text, encoding="utf-8")
     out = tmp_path / "out"
     run = h.generate("--spec", spec, "--out", out)
     if run.code == 2:
-        assert f": {located_at}" in run.stderr, run.stderr
+        assert any(f": {path}" in run.stderr for path in located_at), run.stderr
         assert not out.exists()
         return None
     assert run.code == 0, run.stderr
@@ -111,3 +111,24 @@ def test_a_command_name_cannot_shadow_what_the_generated_module_uses(name: str, 
         "print('ok')\n"
     )
     assert python_runs(out, check) == "ok"
+
+
+@pytest.mark.parametrize("length", [7, 8])
+def test_an_accepted_frame_length_gives_working_code(length: int, tmp_path: Path) -> None:
+    """frame.length may be 3..8 by the validator; wider value fields must work on both ends, or be refused."""
+    text = h.edited_spec(("  length: 6", f"  length: {length}")).replace("    width: 4\n", f"    width: {length - 2}\n")
+    out = generate_or_reject(tmp_path, text, "frame.length", "fields.speed.width")
+    if out is None:
+        return
+    frame = b"sr" + b"45".rjust(length - 2, b"0")
+    assert python_runs(out, "import drone_protocol as p; print(p.servo_right(45), p.decode(p.servo_right(45)).value)") \
+        == f"{frame!r} 45"
+    cpp_compiles(out)
+    vectors = json.loads((out / "vectors.json").read_text())["vectors"]
+    driver = h.compile_cpp(h.CPP_DIR / "protocol_driver.cpp", f"protocol_driver_{length}",
+                           include=out / "arduino" / "DroneProtocol" / "src")
+    proc = subprocess.run([str(driver), "decode"], input="".join(v["frame_hex"] + "\n" for v in vectors),
+                          capture_output=True, text=True, timeout=60)
+    expected = [f"ok {v['command']} {ord(v['category'])} {ord(v['direction'])} {v['value']}" if v["ok"]
+                else f"err {v['error']}" for v in vectors]
+    assert proc.stdout.splitlines() == expected

@@ -251,3 +251,36 @@ def test_a_new_init_command_needs_no_other_change(tmp_path: Path) -> None:
     code = "import drone_protocol as p; print(p.zoom(), p.decode(p.zoom()).name)"
     proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
     assert proc.stdout.strip() == "b'iz0000' zoom", proc.stderr
+
+
+AVR_SKETCH = """
+#include <DroneProtocol.h>
+using drone_protocol::Command;
+struct Handlers {
+  volatile uint16_t last;
+  void on_move(const Command& c) { last = c.value; }
+  void on_turn(const Command& c) { last = c.value; }
+  void on_servo(const Command& c) { last = c.value; }
+  void on_laser(const Command& c) { last = c.value; }
+  void on_init(const Command& c) { last = c.value; }
+  void on_gripper(const Command& c) { last = c.value; }
+};
+drone_protocol::StreamParser parser;
+Handlers handlers;
+volatile uint8_t rx;
+int main() {
+  for (uint32_t now = 0;; ++now) {
+    if (parser.feed(rx, now)) drone_protocol::dispatch(parser.command(), handlers);
+  }
+}
+"""
+
+
+def test_the_new_header_builds_for_the_arduino_uno_with_avr_gcc(edited: Path) -> None:
+    include = edited / "generated" / "arduino" / "DroneProtocol" / "src"
+    source = edited / "sketch.cpp"
+    source.write_text(AVR_SKETCH)
+    proc = subprocess.run(["avr-g++", "-std=gnu++11", "-mmcu=atmega328p", "-Os", "-Wall", "-Wextra", "-Werror",
+                           f"-I{include}", str(source), "-o", str(edited / "sketch.elf")],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
