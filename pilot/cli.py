@@ -246,6 +246,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         cfg = _load_config(args)
         if args.port and args.sim:
             raise PilotError("options --sim and --port exclude each other")
+        if args.sim:
+            return _fly_sim(args, cfg)
         if args.port or args.dry_run or args.camera is not None or args.video or args.images:
             if not args.port:
                 args.dry_run = True  # frames without a drone: decide and print
