@@ -2,6 +2,7 @@
 # Included by the top Makefile:  `make fuzz-smoke` (part of `make test`, ~20 s)  and  `make fuzz` (5 minutes).
 # Everything is built into build/fuzz/; the growing corpus stays in build/fuzz/corpus between runs, and a crash
 # leaves its input in build/fuzz/artifacts/ (replay: build/fuzz/fuzz_stream_parser build/fuzz/artifacts/crash-...).
+# With FUZZ_JOBS > 1 each worker logs to build/fuzz/fuzz-N.log.
 
 FUZZ_DIR := build/fuzz
 FUZZ_CXX ?= clang++
@@ -14,8 +15,9 @@ FUZZ_DICT := $(FUZZ_DIR)/protocol.dict
 FUZZ_SMOKE_SECONDS ?= 20
 FUZZ_SECONDS ?= 300
 FUZZ_JOBS ?= 1
-FUZZ_ARGS = -dict=$(FUZZ_DICT) -artifact_prefix=$(FUZZ_DIR)/artifacts/ -max_len=256 -timeout=10 \
-            -rss_limit_mb=2048 -print_final_stats=1
+# Runs inside $(FUZZ_DIR) (parallel jobs write their fuzz-N.log files there), so the paths are relative to it.
+FUZZ_ARGS = -dict=protocol.dict -artifact_prefix=artifacts/ -max_len=256 -timeout=10 -rss_limit_mb=2048 \
+            -print_final_stats=1
 FUZZ_ENV := ASAN_OPTIONS=abort_on_error=1:detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 
 $(FUZZ_BIN): tests/fuzz/fuzz_stream_parser.cpp $(FUZZ_HEADER) tests/fuzz/fuzz.mk | $(APT_STAMP)
@@ -29,10 +31,10 @@ $(FUZZ_DICT): generated/vectors.json tests/fuzz/make_fuzz_seeds.py | $(VENV_STAM
 # Brief run on every `make test`: the seeds (every conformance vector) first, then new inputs.
 fuzz-smoke: $(FUZZ_BIN) $(FUZZ_DICT)
 	@mkdir -p $(FUZZ_DIR)/corpus $(FUZZ_DIR)/artifacts
-	$(FUZZ_ENV) $(FUZZ_BIN) $(FUZZ_ARGS) -max_total_time=$(FUZZ_SMOKE_SECONDS) $(FUZZ_DIR)/corpus $(FUZZ_SEEDS)
+	cd $(FUZZ_DIR) && $(FUZZ_ENV) ./$(notdir $(FUZZ_BIN)) $(FUZZ_ARGS) -max_total_time=$(FUZZ_SMOKE_SECONDS) corpus seeds
 
 # Longer run (FUZZ_SECONDS, FUZZ_JOBS parallel workers), e.g.  make fuzz FUZZ_SECONDS=3600 FUZZ_JOBS=4
 fuzz: $(FUZZ_BIN) $(FUZZ_DICT)
 	@mkdir -p $(FUZZ_DIR)/corpus $(FUZZ_DIR)/artifacts
-	$(FUZZ_ENV) $(FUZZ_BIN) $(FUZZ_ARGS) -max_total_time=$(FUZZ_SECONDS) -jobs=$(FUZZ_JOBS) -workers=$(FUZZ_JOBS) \
-	    $(FUZZ_DIR)/corpus $(FUZZ_SEEDS)
+	cd $(FUZZ_DIR) && $(FUZZ_ENV) ./$(notdir $(FUZZ_BIN)) $(FUZZ_ARGS) -max_total_time=$(FUZZ_SECONDS) \
+	    $(if $(filter-out 1,$(FUZZ_JOBS)),-jobs=$(FUZZ_JOBS) -workers=$(FUZZ_JOBS)) corpus seeds
