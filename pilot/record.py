@@ -70,6 +70,7 @@ class Recorder:
                 "t": round(tick.t, 3),
                 "tick": tick.index,
                 "state": tick.state.value,
+                "laser": tick.laser_on,
                 "detection": None
                 if det is None
                 else {
@@ -102,6 +103,9 @@ class Recorder:
         scale = max(0.35, w / 900)
         cv2.putText(img, f"{tick.t:6.2f}s {tick.state.value}", (4, int(14 * scale / 0.35)), font, scale, (0, 0, 0), 1)
         cv2.putText(img, f"cmd {self._last_command}", (4, h - 6), font, scale, (0, 0, 0), 1)
+        if tick.laser_on:
+            cv2.putText(img, "LASER", (w - int(60 * scale / 0.35), int(14 * scale / 0.35)), font, scale, (0, 0, 255), 1)
+            cv2.circle(img, (w // 2, h // 2), 3, (0, 0, 255), -1)
         self._writer.write(img)
 
     def path_png(self, scenario: Scenario, path: list[tuple[float, float, float, float]], scale: int = 60) -> Path:

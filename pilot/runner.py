@@ -94,6 +94,7 @@ class Tick:
     replies: tuple[dp.Reply, ...]
     frame_t: float  # when the frame arrived (the wall clock)
     sent_t: float | None  # when its command's last byte was written and flushed (the wall clock), if any
+    laser_on: bool = False  # what the pilot believes of the laser after this tick
 
 
 class Observer(Protocol):
@@ -189,7 +190,10 @@ def run(
             replies = sink.poll()
             for reply in replies:
                 controller.on_reply(reply)
-            tick = Tick(ticks, now, frame, det, controller.state, command, tuple(replies), frame_wall, sent_t)
+            tick = Tick(
+                ticks, now, frame, det, controller.state, command, tuple(replies), frame_wall, sent_t,
+                laser_on=controller.laser_on,
+            )
             for w in watchers:
                 w.on_tick(tick)
             ticks += 1
