@@ -36,21 +36,24 @@ class LogEntry:
     data: str
 
 
-def _open_device(path: str, baud: int) -> Any:
-    """Open a device path without pyserial's input flush on open.
+def _open_keeping_input(url: str, baud: int) -> Any:
+    """Open a port or URL without pyserial's input flush on open.
 
-    pyserial discards waiting input when it opens a port. A real Arduino resets on open and prints
-    its ready line afterwards, but a board (or the virtual drone's pseudo-terminal) that was already
-    running may have printed it before: discarding it would make the ready-line wait fail. Nothing is
-    lost by keeping the stale input: ``await_ready`` skips every line before the ready line.
+    pyserial discards waiting input when it opens a port (``socket://`` even reads it away). A real
+    Arduino resets on open and prints its ready line afterwards, but a board, a serial bridge or the
+    virtual drone's pseudo-terminal that was already running may have printed it just before:
+    discarding it would make the ready-line wait fail. Nothing is lost by keeping stale input:
+    ``await_ready`` skips every line before the ready line.
     """
-    port = serial.Serial(None, baudrate=baud, timeout=0, write_timeout=1.0)
-    port.port = path
-    port._reset_input_buffer = lambda: None  # instance override, for open() only
+    port = serial.serial_for_url(url, baudrate=baud, timeout=0, write_timeout=1.0, do_not_open=True)
+    names = ("reset_input_buffer", "_reset_input_buffer")
+    for name in names:
+        setattr(port, name, lambda: None)  # instance overrides, for open() only
     try:
         port.open()
     finally:
-        del port._reset_input_buffer
+        for name in names:
+            delattr(port, name)
     return port
 
 
@@ -113,10 +116,7 @@ class Link:
                 raise LinkError("link: no port to open")
             return
         try:
-            if "://" in self._url:
-                self._port = serial.serial_for_url(self._url, baudrate=self.baud, timeout=0, write_timeout=1.0)
-            else:
-                self._port = _open_device(self._url, self.baud)
+            self._port = _open_keeping_input(self._url, self.baud)
         except (serial.SerialException, OSError, ValueError) as exc:
             raise LinkError(f"link {self._url!r}: cannot open: {exc}") from exc
 
@@ -158,8 +158,8 @@ class Link:
     def _read_lines(self) -> list[bytes]:
         if self._port is None:
             return []
-        waiting = self._port.in_waiting
-        chunk = self._port.read(waiting or 1) if waiting else b""
+        waiting = self._port.in_waiting  # some handlers (socket://) only say 0 or 1
+        chunk = self._port.read(max(waiting, 256)) if waiting else b""
         if not chunk:
             return []
         self._buffer.extend(chunk)
