@@ -175,9 +175,10 @@ class _Builder:
         if encoding is not None and encoding != "ascii":
             frame.error(frame.node.children["encoding"], f"unsupported encoding '{encoding}'", "only ascii",
                         frame.sub("encoding"))
-        if length is not None and not 3 <= length <= 8:
-            frame.error(frame.node.children["length"], f"frame length {length} is not in 3..8",
-                        "a frame is category, direction and 1 to 6 value digits", frame.sub("length"))
+        if _is_int(frame.node.children.get("length")) and not 3 <= length <= 6:
+            frame.error(frame.node.children["length"], f"frame length {length} is not in 3..6",
+                        "a frame is category, direction and 1 to 4 value digits (16-bit values on the Arduino)",
+                        frame.sub("length"))
         inter_byte = self._positive(frame, "inter_byte_timeout_ms")
         frame.finish()
 
@@ -253,8 +254,7 @@ class _Builder:
     def _positive(self, reader: Reader, key: str) -> int:
         value = reader.integer(key)
         node = reader.node.children.get(key) if reader.ok else None
-        valid = node is not None and isinstance(node.value, int) and not isinstance(node.value, bool)
-        if node is not None and valid and value <= 0:
+        if node is not None and _is_int(node) and value <= 0:
             reader.error(node, f"{key} must be positive, found {value}", path=reader.sub(key))
         return value
 
@@ -582,6 +582,10 @@ class _Builder:
                 out.append(Settled(r.text("title"), r.text("seed"), r.text("decision")))
                 r.finish()
         return out
+
+
+def _is_int(node: Node | None) -> bool:
+    return node is not None and isinstance(node.value, int) and not isinstance(node.value, bool)
 
 
 def _is_code(code: str) -> bool:

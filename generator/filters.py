@@ -16,7 +16,8 @@ def cpp_char(code: str) -> str:
 
 
 def cpp_string(text: str) -> str:
-    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    """A C++ string literal of printable ASCII text (and newlines)."""
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
 
 
 def py_string(text: str) -> str:
@@ -30,8 +31,8 @@ def py_bytes(text: str) -> str:
 
 
 def docstring(text: str) -> str:
-    """Text safe inside a triple-quoted docstring (the spec rejects backslashes)."""
-    return text.replace('"', '\\"')
+    """Text safe inside a triple-quoted docstring: codes may be a backslash or a quote."""
+    return text.replace("\\", "\\\\").replace('"', '\\"')
 
 
 def md_cell(text: str) -> str:

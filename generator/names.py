@@ -22,11 +22,20 @@ ARDUINO_MACROS = frozenset(
     lowByte highByte bitRead bitSet bitClear bitWrite bit cli sei F isnan isinf putc getc""".split()
 )
 
-# Names the generated code itself defines at module or namespace level.
-GENERATED_NAMES = frozenset(
-    """encode decode dispatch command_info channel_limits error_name error_code parse_reply
-    stream_parser stream_decoder command category direction value name error reply""".split()
+# Builtins the generated Python module calls: a module-level command function of the same name would replace them.
+PYTHON_BUILTINS_USED = frozenset(
+    """bool bytearray bytes chr dict float int isinstance iter len list next object ord property range repr
+    sorted str super tuple type""".split()
 )
+
+# Names the generated code itself defines or uses at module or namespace level: a command function of the
+# same name would replace them.
+GENERATED_NAMES = frozenset(
+    """encode decode dispatch command_info command_name channel_limits error_name error_code parse_reply
+    ready_line accepted_line rejected_line failsafe_line write_ready write_accepted write_rejected
+    write_failsafe stream_parser stream_decoder command category direction value name error reply time
+    dataclass annotations detail""".split()
+) | PYTHON_BUILTINS_USED
 
 RESERVED = frozenset(keyword.kwlist) | frozenset(keyword.softkwlist) | CPP_KEYWORDS | ARDUINO_MACROS
 

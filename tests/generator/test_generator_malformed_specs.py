@@ -148,8 +148,8 @@ CASES = [
     Case("sense other than 1 or -1", ((SENSE_1, "        servo: tilt\n        sense: 2"),),
          (("sense: ^2", "categories.s.directions.u.sense: sense must be 1 or -1, found 2"),)),
     Case("frame length out of bounds", (("  length: 6", "  length: 9"),),
-         (("length: ^9", "frame.length: frame length 9 is not in 3..8 "
-           "(hint: a frame is category, direction and 1 to 6 value digits)"),
+         (("length: ^9", "frame.length: frame length 9 is not in 3..6 "
+           "(hint: a frame is category, direction and 1 to 4 value digits (16-bit values on the Arduino))"),
           ("  speed:\n    width: ^4", "fields.speed.width: width 4 does not fill the frame "
            "(hint: frame.length 9 leaves 7 value digits)"),
           ("  angle:\n    width: ^4", "fields.angle.width: width 4 does not fill the frame "

@@ -651,66 +651,66 @@ class StreamDecoder:
                 del buffer[0]
         return out
 
-_MOVE_FORWARD: Final = COMMANDS["move_forward"]
-_MOVE_BACKWARD: Final = COMMANDS["move_backward"]
-_MOVE_LEFT: Final = COMMANDS["move_left"]
-_MOVE_RIGHT: Final = COMMANDS["move_right"]
-_MOVE_UP: Final = COMMANDS["move_up"]
-_MOVE_DOWN: Final = COMMANDS["move_down"]
-_TURN_LEFT: Final = COMMANDS["turn_left"]
-_TURN_RIGHT: Final = COMMANDS["turn_right"]
-_SERVO_UP: Final = COMMANDS["servo_up"]
-_SERVO_DOWN: Final = COMMANDS["servo_down"]
-_SERVO_LEFT: Final = COMMANDS["servo_left"]
-_SERVO_RIGHT: Final = COMMANDS["servo_right"]
+_CMD_MOVE_FORWARD: Final = COMMANDS["move_forward"]
+_CMD_MOVE_BACKWARD: Final = COMMANDS["move_backward"]
+_CMD_MOVE_LEFT: Final = COMMANDS["move_left"]
+_CMD_MOVE_RIGHT: Final = COMMANDS["move_right"]
+_CMD_MOVE_UP: Final = COMMANDS["move_up"]
+_CMD_MOVE_DOWN: Final = COMMANDS["move_down"]
+_CMD_TURN_LEFT: Final = COMMANDS["turn_left"]
+_CMD_TURN_RIGHT: Final = COMMANDS["turn_right"]
+_CMD_SERVO_UP: Final = COMMANDS["servo_up"]
+_CMD_SERVO_DOWN: Final = COMMANDS["servo_down"]
+_CMD_SERVO_LEFT: Final = COMMANDS["servo_left"]
+_CMD_SERVO_RIGHT: Final = COMMANDS["servo_right"]
 
 def move_forward(speed: int | None = None) -> bytes:
     """Forward at `speed` (1000..2000 us, default 1600)."""
-    return _frame(_MOVE_FORWARD, 1600 if speed is None else speed)
+    return _frame(_CMD_MOVE_FORWARD, 1600 if speed is None else speed)
 
 def move_backward(speed: int | None = None) -> bytes:
     """Backward at `speed` (1000..2000 us, default 1400)."""
-    return _frame(_MOVE_BACKWARD, 1400 if speed is None else speed)
+    return _frame(_CMD_MOVE_BACKWARD, 1400 if speed is None else speed)
 
 def move_left(speed: int | None = None) -> bytes:
     """Strafe left at `speed` (1000..2000 us, default 1400)."""
-    return _frame(_MOVE_LEFT, 1400 if speed is None else speed)
+    return _frame(_CMD_MOVE_LEFT, 1400 if speed is None else speed)
 
 def move_right(speed: int | None = None) -> bytes:
     """Strafe right at `speed` (1000..2000 us, default 1600)."""
-    return _frame(_MOVE_RIGHT, 1600 if speed is None else speed)
+    return _frame(_CMD_MOVE_RIGHT, 1600 if speed is None else speed)
 
 def move_up(speed: int | None = None) -> bytes:
     """Up (increase altitude) at `speed` (1029..2012 us, default 1621)."""
-    return _frame(_MOVE_UP, 1621 if speed is None else speed)
+    return _frame(_CMD_MOVE_UP, 1621 if speed is None else speed)
 
 def move_down(speed: int | None = None) -> bytes:
     """Down (decrease altitude) at `speed` (1029..2012 us, default 1421)."""
-    return _frame(_MOVE_DOWN, 1421 if speed is None else speed)
+    return _frame(_CMD_MOVE_DOWN, 1421 if speed is None else speed)
 
 def turn_left(speed: int | None = None) -> bytes:
     """Turn left at `speed` (1035..2012 us, default 1424)."""
-    return _frame(_TURN_LEFT, 1424 if speed is None else speed)
+    return _frame(_CMD_TURN_LEFT, 1424 if speed is None else speed)
 
 def turn_right(speed: int | None = None) -> bytes:
     """Turn right at `speed` (1035..2012 us, default 1624)."""
-    return _frame(_TURN_RIGHT, 1624 if speed is None else speed)
+    return _frame(_CMD_TURN_RIGHT, 1624 if speed is None else speed)
 
 def servo_up(degrees: int) -> bytes:
     """Up by `degrees` (1..180 deg)."""
-    return _frame(_SERVO_UP, degrees)
+    return _frame(_CMD_SERVO_UP, degrees)
 
 def servo_down(degrees: int) -> bytes:
     """Down by `degrees` (1..180 deg)."""
-    return _frame(_SERVO_DOWN, degrees)
+    return _frame(_CMD_SERVO_DOWN, degrees)
 
 def servo_left(degrees: int) -> bytes:
     """Left by `degrees` (1..180 deg)."""
-    return _frame(_SERVO_LEFT, degrees)
+    return _frame(_CMD_SERVO_LEFT, degrees)
 
 def servo_right(degrees: int) -> bytes:
     """Right by `degrees` (1..180 deg)."""
-    return _frame(_SERVO_RIGHT, degrees)
+    return _frame(_CMD_SERVO_RIGHT, degrees)
 
 def servo_reset() -> bytes:
     """Reset both servos to their default positions: `sx0000`."""
