@@ -108,7 +108,7 @@ class _StillSim:
         self.scenario = make_scenario(scenario_name, seed)
         self.renderer = Renderer(self.scenario, CameraModel(*size))
         x, y, heading = self.scenario.start
-        self.pose = CameraPose.from_drone(x, y, 1.2, heading, 90.0, 90.0)
+        self.pose = CameraPose.from_drone(x, y, 1.2, heading, dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default)
         self._index = 0
 
     def read(self) -> Frame | None:

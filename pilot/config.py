@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
 
+import drone_protocol as dp
 import yaml
 
 from pilot.errors import ConfigError
@@ -63,7 +64,7 @@ class ControllerConfig:
 class LinkConfig:
     rate_hz: float = 20.0
     keepalive_fraction: float = 0.4  # keep-alive period as a fraction of the firmware's command timeout
-    ready_timeout_s: float = 5.0
+    ready_timeout_s: float = dp.READY_TIMEOUT_MS / 1000.0  # the spec's
     reconnect_s: float = 3.0  # how long to try to reopen a lost port before giving up
 
 

@@ -18,6 +18,7 @@ import time
 from pathlib import Path
 
 import cv2
+import drone_protocol as dp
 import numpy as np
 
 from pilot.config import HsvConfig
@@ -52,7 +53,8 @@ def frame_of(width: int, height: int) -> np.ndarray:
     heading = float(np.arctan2(ty - y, tx - x))
     d = float(np.hypot(tx - x, ty - y))
     k = (d - 2.0) / d  # two metres from the target
-    pose = CameraPose.from_drone(x + (tx - x) * k, y + (ty - y) * k, tz - 0.2, heading, 90.0, 90.0)
+    pan0, tilt0 = dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default
+    pose = CameraPose.from_drone(x + (tx - x) * k, y + (ty - y) * k, tz - 0.2, heading, pan0, tilt0)
     return r.render(pose, 0.0)
 
 

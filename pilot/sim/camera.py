@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass
 
 import cv2
+import drone_protocol as dp
 import numpy as np
 import numpy.typing as npt
 
@@ -48,8 +49,10 @@ class CameraPose:
 
     @staticmethod
     def from_drone(x: float, y: float, z: float, heading: float, pan_deg: float, tilt_deg: float) -> CameraPose:
-        """Servo angles: 90 is straight ahead/level; pan above 90 looks right, tilt above 90 looks up."""
-        return CameraPose((x, y, z), heading - math.radians(pan_deg - 90.0), math.radians(tilt_deg - 90.0))
+        """Servo angles in degrees: at the spec's defaults (``drone_protocol.SERVOS``) the camera looks straight
+        ahead and level; pan above its default looks right (``servo_right``), tilt above looks up (``servo_up``)."""
+        pan0, tilt0 = dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default
+        return CameraPose((x, y, z), heading - math.radians(pan_deg - pan0), math.radians(tilt_deg - tilt0))
 
     def axes(self) -> tuple[FloatArray, FloatArray, FloatArray]:
         cy, sy = math.cos(self.yaw), math.sin(self.yaw)

@@ -11,7 +11,8 @@ job real. Each stick is read against its Table 4 median (taken from ``drone_prot
   (m/s per 100 µs) for pitch and roll, ``climb_per_100us`` for throttle, ``yaw_deg_per_100us``
   for yaw, clamped to ``max_speed``/``max_climb``/``max_yaw_deg``; the airframe follows with
   a first-order lag (``tau_xy``, ``tau_z``, ``tau_yaw`` seconds);
-* throttle below ``land_below_us`` (the firmware's failsafe throttle) descends at ``land_speed``;
+* throttle below the channel's recorded minimum (only the firmware's failsafe throttle goes there)
+  descends at ``land_speed``;
 * disarmed: the motors stop; in the air it drops at ``drop_speed`` (a crash, counted);
 * the room's walls, floor and ceiling stop it: touching a wall (within ``radius`` of it) counts as a
   wall hit; the floor is where it lands.
@@ -31,6 +32,7 @@ class StickCentres:
     pitch: int
     throttle: int
     yaw: int
+    throttle_minimum: int  # the recorded minimum: below it only the failsafe's throttle goes
 
     @staticmethod
     def from_protocol() -> StickCentres:
@@ -42,6 +44,7 @@ class StickCentres:
             pitch=int(ch["pitch"].median),
             throttle=int(ch["throttle"].median),
             yaw=int(ch["yaw"].median),
+            throttle_minimum=int(ch["throttle"].minimum),
         )
 
 
@@ -57,7 +60,6 @@ class ModelParams:
     tau_xy: float = 0.25
     tau_z: float = 0.25
     tau_yaw: float = 0.12
-    land_below_us: float = 1000.0
     land_speed: float = 0.8
     drop_speed: float = 3.0
     radius: float = 0.25
@@ -71,11 +73,11 @@ class Outputs:
     pitch: int
     throttle: int
     yaw: int
-    mode: int = 0
-    pan: float = 90.0
-    tilt: float = 90.0
-    laser: bool = False
-    armed: bool = False
+    mode: int
+    pan: float
+    tilt: float
+    laser: bool
+    armed: bool
 
 
 @dataclass
@@ -122,7 +124,7 @@ class DroneModel:
             want_yaw = -math.radians(
                 max(-p.max_yaw_deg, min(p.max_yaw_deg, p.yaw_deg_per_100us * self._stick(out.yaw, c.yaw)))
             )
-            if out.throttle < p.land_below_us:
+            if out.throttle < c.throttle_minimum:
                 want_up = -p.land_speed
             else:
                 want_up = max(-p.max_climb, min(p.max_climb, p.climb_per_100us * self._stick(out.throttle, c.throttle)))

@@ -23,6 +23,8 @@ from pilot.sim.model import DroneModel, Outputs, StickCentres
 from pilot.sim.room import SCENARIOS, Room, make_scenario
 from pilot.sources import CameraSource, ImageFolderSource, VideoFileSource
 
+PAN0, TILT0 = dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default
+
 # -- config --------------------------------------------------------------------------------------------
 
 
@@ -177,6 +179,10 @@ def neutral(**kw: int | bool) -> Outputs:
         "pitch": ch["pitch"].median,
         "throttle": ch["throttle"].median,
         "yaw": ch["yaw"].median,
+        "mode": 0,
+        "pan": dp.SERVOS["pan"].default,
+        "tilt": dp.SERVOS["tilt"].default,
+        "laser": False,
         "armed": True,
     }
     base.update(kw)
@@ -251,7 +257,7 @@ def test_render_is_deterministic_and_detects_where_it_projects() -> None:
     x, y, _ = sc.start
     tx, ty, _tz = sc.target.position
     heading = math.atan2(ty - y, tx - x) + math.radians(8)
-    pose = CameraPose.from_drone(x, y, 1.2, heading, 90.0, 90.0)
+    pose = CameraPose.from_drone(x, y, 1.2, heading, PAN0, TILT0)
     a = Renderer(sc, cam).render(pose, 1.0)
     b = Renderer(sc, cam).render(pose, 1.0)
     assert np.array_equal(a, b)
@@ -270,10 +276,10 @@ def test_render_tilt_moves_the_horizon_and_hidden_hides_the_target() -> None:
     x, y, _ = sc.start
     tx, ty, _ = sc.target.position
     heading = math.atan2(ty - y, tx - x)
-    level = r.render(CameraPose.from_drone(x, y, 1.2, heading, 90, 90), 0.0)
-    up = r.render(CameraPose.from_drone(x, y, 1.2, heading, 90, 110), 0.0)
+    level = r.render(CameraPose.from_drone(x, y, 1.2, heading, PAN0, TILT0), 0.0)
+    up = r.render(CameraPose.from_drone(x, y, 1.2, heading, PAN0, TILT0 + 20), 0.0)
     det = HsvBlobDetector()
     d_level, d_up = det.detect(level), det.detect(up)
     assert d_level.found and d_up.found and d_up.cy > d_level.cy + 50  # looking up: the target drops
-    during = r.render(CameraPose.from_drone(x, y, 1.2, heading, 90, 90), sc.hidden[0].start + 0.1)
+    during = r.render(CameraPose.from_drone(x, y, 1.2, heading, PAN0, TILT0), sc.hidden[0].start + 0.1)
     assert not det.detect(during).found
