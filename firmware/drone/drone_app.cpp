@@ -89,6 +89,8 @@ void bench_mark() { *portInputRegister(digitalPinToPort(DRONE_MARK_PIN)) = digit
 void setup() {
   pinMode(pins::LASER, OUTPUT);
   digitalWrite(pins::LASER, LOW);
+  laser_written = false;
+  widths_pending = false;
 #ifdef DRONE_MARK_PIN
   pinMode(DRONE_MARK_PIN, OUTPUT);
 #endif

@@ -53,6 +53,10 @@ std::string tx_take(size_t max) {
   return out;
 }
 uint32_t serial_baud() { return g_baud; }
+void reset_serial() {
+  g_rx.clear();
+  g_tx.clear();
+}
 int pin(uint8_t p) { return digitalRead(p); }
 
 }  // namespace fake

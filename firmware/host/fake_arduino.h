@@ -23,6 +23,8 @@ size_t rx_space();
 // them; the rest stay in the 64-byte buffer and keep it full.
 std::string tx_take(size_t max = static_cast<size_t>(-1));
 uint32_t serial_baud();
+// Empties both serial buffers, as a board reset does.
+void reset_serial();
 int pin(uint8_t pin);
 
 }  // namespace fake

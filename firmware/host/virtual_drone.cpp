@@ -2,9 +2,11 @@
 // over a pseudo-terminal (or stdin), reporting its outputs as JSON lines.
 //
 //   virtual_drone [--clock realtime|stepped] [--stdin] [--duration MS]
+//                 [--no-reset-on-open]
 //
 // pty mode (default): prints {"pty": "/dev/pts/N"} first; the Pi side opens
-//   that path. Replies go back over the pty.
+//   that path. Replies go back over the pty. Opening the port reboots the
+//   virtual board (as DTR does a real Uno): it prints its ready line again.
 // --clock stepped: stdin carries "step <ms>" lines; each one reads the bytes
 //   waiting on the pty, runs the loop 1 ms at a time, prints the change lines
 //   and then {"tick": t_ms}. Nothing depends on the wall clock.
@@ -17,6 +19,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/inotify.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -35,9 +38,13 @@ struct Options {
   Clock clock = Clock::Realtime;
   bool use_stdin = false;
   long duration_ms = -1;
+  bool reset_on_open = true;
 };
 
 int g_master = -1;
+int g_inotify = -1;  // watches the pty's slave node for opens
+int g_slave = -1;    // our own slave descriptor, which keeps the port raw
+int g_clients = 0;   // descriptors others hold on the slave node
 std::deque<uint8_t> g_pending;  // bytes "on the wire", not yet in the UART
 uint32_t g_byte_credit = 0;     // receive line, in 1/10000 byte units
 uint32_t g_tx_credit = 0;       // transmit line, same units
@@ -101,7 +108,7 @@ void send_replies() {
       fputs(line.c_str(), stdout);
       partial.erase(0, nl + 1);
     }
-  } else if (g_master >= 0) {
+  } else if (g_master >= 0 && (g_inotify < 0 || g_clients > 0)) {
     // Non-blocking: with nobody reading, replies are lost, as on a real UART.
     ssize_t r = write(g_master, tx.data(), tx.size());
     (void)r;
@@ -126,7 +133,37 @@ void run_one_ms() {
   report_if_changed();
 }
 
+// A client opened the port: reboot the firmware (state, buffers, ready line).
+void reset_if_opened() {
+  if (g_inotify < 0) return;
+  alignas(inotify_event) char buf[4096];
+  bool opened = false;
+  for (;;) {
+    const ssize_t n = read(g_inotify, buf, sizeof buf);
+    if (n <= 0) break;
+    for (ssize_t i = 0; i < n;) {
+      const inotify_event* e = reinterpret_cast<const inotify_event*>(buf + i);
+      if (e->mask & IN_OPEN) {
+        ++g_clients;
+        opened = true;
+      }
+      if ((e->mask & (IN_CLOSE_WRITE | IN_CLOSE_NOWRITE)) && g_clients > 0) --g_clients;
+      i += static_cast<ssize_t>(sizeof(inotify_event) + e->len);
+    }
+  }
+  if (!opened) return;
+  // What the old "board" sent before the port opened is gone, as on a USB
+  // serial port that was closed.
+  if (g_slave >= 0) tcflush(g_slave, TCIFLUSH);
+  g_pending.clear();
+  fake::reset_serial();
+  drone_app::setup();
+  send_replies();
+  report_if_changed();
+}
+
 void read_master() {
+  reset_if_opened();
   if (g_master < 0) return;
   uint8_t buf[256];
   for (;;) {
@@ -146,6 +183,7 @@ int open_pty() {
   // Keep a slave descriptor open ourselves: the master then never sees a
   // hang-up between clients, and the port is raw from the start (no echo).
   const int s = open(name, O_RDWR | O_NOCTTY);
+  g_slave = s;
   if (s >= 0) {
     termios tio;
     tcgetattr(s, &tio);
@@ -153,6 +191,15 @@ int open_pty() {
     tcsetattr(s, TCSANOW, &tio);
   }
   fcntl(m, F_SETFL, fcntl(m, F_GETFL) | O_NONBLOCK);
+  // Opening a real Uno's port pulses DTR and resets the board; the Pi waits
+  // for the ready line. A client opening the slave node does the same here.
+  if (g_opt.reset_on_open) {
+    g_inotify = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
+    if (g_inotify >= 0 && inotify_add_watch(g_inotify, name, IN_OPEN | IN_CLOSE_WRITE | IN_CLOSE_NOWRITE) < 0) {
+      close(g_inotify);
+      g_inotify = -1;
+    }
+  }
   printf("{\"pty\": \"%s\"}\n", name);
   fflush(stdout);
   return m;
@@ -245,7 +292,7 @@ int run_realtime() {
 }
 
 void usage() {
-  fputs("usage: virtual_drone [--clock realtime|stepped] [--stdin] [--duration MS]\n", stderr);
+  fputs("usage: virtual_drone [--clock realtime|stepped] [--stdin] [--duration MS] [--no-reset-on-open]\n", stderr);
   exit(2);
 }
 
@@ -263,6 +310,8 @@ int main(int argc, char** argv) {
       } else {
         usage();
       }
+    } else if (a == "--no-reset-on-open") {
+      g_opt.reset_on_open = false;
     } else if (a == "--stdin") {
       g_opt.use_stdin = true;
     } else if (a == "--duration" && i + 1 < argc) {

@@ -369,7 +369,8 @@ def test_random_bytes_never_drive_an_output_outside_its_limits(chunks: list[byte
 
 
 def test_virtual_drone_over_a_pty_with_the_stepped_clock() -> None:
-    """The pilot's simulator interface: JSON pty line, `step` lines on stdin, replies on the pty."""
+    """The pilot's simulator interface: JSON pty line, `step` lines on stdin, replies on the pty; opening the
+    port reboots the virtual board as DTR reboots an Uno (ready line again, outputs back to boot state)."""
     proc = subprocess.Popen(
         [str(fw.VIRTUAL_DRONE), "--clock", "stepped"],
         stdin=subprocess.PIPE,
@@ -377,26 +378,47 @@ def test_virtual_drone_over_a_pty_with_the_stepped_clock() -> None:
         text=True,
     )
     assert proc.stdin is not None and proc.stdout is not None
+    stdin, stdout = proc.stdin, proc.stdout
+
+    def step(ms: int) -> list[dict[str, Any]]:
+        stdin.write(f"step {ms}\n")
+        stdin.flush()
+        lines = []
+        while "tick" not in (line := json.loads(stdout.readline())):
+            lines.append(line)
+        return [*lines, line]
+
+    def read_until(fd: int, end: bytes) -> bytes:
+        received = b""
+        while not received.endswith(end):
+            ready, _, _ = select.select([fd], [], [], 5)
+            assert ready, f"no reply on the pty, got {received!r}"
+            received += os.read(fd, 256)
+        return received
+
     try:
-        first = json.loads(proc.stdout.readline())
-        fd = os.open(first["pty"], os.O_RDWR | os.O_NOCTTY)
+        pty = json.loads(stdout.readline())["pty"]
+        boot = json.loads(stdout.readline())
+        assert boot["state"] == "disarmed" and boot["t_ms"] == 0
+        assert step(5) == [{"tick": 5}]
+        fd = os.open(pty, os.O_RDWR | os.O_NOCTTY)
         try:
-            boot = json.loads(proc.stdout.readline())
-            assert boot["state"] == "disarmed" and boot["t_ms"] == 0
+            assert not select.select([fd], [], [], 0.05)[0]  # the boot banner went nowhere: the port was closed
             os.write(fd, dp.laser_toggle())
-            proc.stdin.write("step 10\n")
-            proc.stdin.flush()
-            change = json.loads(proc.stdout.readline())
-            assert change["laser"] is True and change["t_ms"] == 1
-            assert json.loads(proc.stdout.readline()) == {"tick": 10}
-            received = b""
-            while not received.endswith(b"Al0\n"):
-                ready, _, _ = select.select([fd], [], [], 5)
-                assert ready, f"no reply on the pty, got {received!r}"
-                received += os.read(fd, 256)
-            assert received.startswith(dp.ready_line())
+            lines = step(10)
+            assert lines[-1] == {"tick": 15}
+            (change,) = lines[:-1]
+            assert change["laser"] is True and change["t_ms"] == 6
+            assert read_until(fd, b"Al0\n") == dp.ready_line() + b"Al0\n"
+        finally:
+            os.close(fd)
+        fd = os.open(pty, os.O_RDWR | os.O_NOCTTY)  # reopening resets the board
+        try:
+            lines = step(10)
+            assert [c["laser"] for c in lines[:-1]] == [False]
+            assert read_until(fd, b"\n") == dp.ready_line()
         finally:
             os.close(fd)
     finally:
-        proc.stdin.close()
+        stdin.close()
         assert proc.wait(timeout=10) == 0
