@@ -16,9 +16,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 TIMEOUT = p.INTER_BYTE_TIMEOUT_MS
-FAST = settings(max_examples=300, deadline=None)
+FAST = settings(max_examples=200, deadline=None)
 # Each example runs the C++ driver once (a few ms).
-CPP = settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+CPP = settings(max_examples=75, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 SPECS = list(p.COMMANDS.values())
 commands = st.sampled_from(SPECS).flatmap(lambda s: st.tuples(st.just(s), st.integers(s.minimum, s.maximum)))

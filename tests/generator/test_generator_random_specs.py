@@ -99,7 +99,7 @@ def frames_from(spec: dict[str, Any], rng: random.Random, count: int) -> list[by
     return out
 
 
-@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(random_specs())
 def test_for_any_valid_spec_python_and_cpp_agree(spec: dict[str, Any]) -> None:
     with tempfile.TemporaryDirectory(prefix="random_spec_") as tmp:
