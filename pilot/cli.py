@@ -57,6 +57,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=1, help="simulated room seed (default 1)")
     p.add_argument("--scenario", choices=SCENARIOS, default="ahead", help="simulated scenario (default ahead)")
     p.add_argument("--max-seconds", type=float, default=60.0, help="flight time limit, seconds (default 60)")
+    p.add_argument("--wind", type=float, default=0.0, help="simulated steady wind, up to this many m/s (default 0)")
     p.add_argument("--size", default="320x240", help="simulated camera frame size (default 320x240)")
     p.add_argument("--virtual-drone", help="the virtual drone executable (default: the firmware's host build)")
     p.add_argument("--no-status", action="store_true", help="no status line")
@@ -151,6 +152,7 @@ def _fly_sim(args: argparse.Namespace, cfg: PilotConfig) -> int:
         camera=CameraModel(*_size(args.size)),
         executable=args.virtual_drone,
         observers=observers,
+        max_wind=args.wind,
     )
     if status is not None:
         status.finish()

@@ -76,6 +76,7 @@ class FlightJob:
     width: int = 320
     height: int = 240
     executable: str | None = None
+    max_wind: float = 0.0
 
 
 def fly(
@@ -91,11 +92,12 @@ def fly(
     executable: str | Path | None = None,
     lose_camera_at_s: float | None = None,
     observers: Sequence[Observer] = (),
+    max_wind: float = 0.0,
 ) -> FlightResult:
     cfg = config or PilotConfig()
     if detector_name is not None:
         cfg = dataclasses.replace(cfg, detector=detector_name)
-    scenario = make_scenario(scenario_name, seed, noise=noise)
+    scenario = make_scenario(scenario_name, seed, noise=noise, max_wind=max_wind)
     detector = make_detector(cfg)
     recorder = Recorder(record_dir, fps=cfg.link.rate_hz) if record_dir is not None else None
     wall0 = time.perf_counter()
@@ -204,6 +206,7 @@ def _fly_job(job: FlightJob) -> FlightResult:
         noise=job.noise,
         camera=CameraModel(job.width, job.height),
         executable=job.executable,
+        max_wind=job.max_wind,
     )
 
 

@@ -14,6 +14,7 @@ job real. Each stick is read against its Table 4 median (taken from ``drone_prot
 * throttle below the channel's recorded minimum (only the firmware's failsafe throttle goes there)
   descends at ``land_speed``;
 * disarmed: the motors stop; in the air it drops at ``drop_speed`` (a crash, counted);
+* airborne, the scenario's steady wind (none by default) drifts it;
 * the room's walls, floor and ceiling stop it: touching a wall (within ``radius`` of it) counts as a
   wall hit; the floor is where it lands.
 """
@@ -97,9 +98,15 @@ class DroneState:
 
 class DroneModel:
     def __init__(
-        self, room: Room, start: tuple[float, float, float], centres: StickCentres, params: ModelParams | None = None
+        self,
+        room: Room,
+        start: tuple[float, float, float],
+        centres: StickCentres,
+        params: ModelParams | None = None,
+        wind: tuple[float, float] = (0.0, 0.0),
     ) -> None:
         self.room = room
+        self.wind = wind
         self.centres = centres
         self.p = params or ModelParams()
         self.state = DroneState(x=start[0], y=start[1], heading=start[2])
@@ -142,6 +149,9 @@ class DroneModel:
         # forward along the heading, right is the heading turned clockwise
         nx = s.x + (s.v_forward * ch + s.v_right * sh) * dt
         ny = s.y + (s.v_forward * sh - s.v_right * ch) * dt
+        if airborne:  # the wind drifts it; nothing holds position but the pilot's corrections
+            nx += self.wind[0] * dt
+            ny += self.wind[1] * dt
         nz = s.z + s.v_up * dt
         r = p.radius
         touching = False

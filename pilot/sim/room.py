@@ -74,6 +74,7 @@ class Scenario:
     light_gain: float = 1.0  # mean lighting gain
     light_wobble: float = 0.0  # amplitude of a slow lighting change
     noise_sigma: float = 0.0  # Gaussian pixel noise
+    wind: tuple[float, float] = (0.0, 0.0)  # steady drift of the airborne drone, m/s along x and y
     time_budget_s: float = 60.0
     wall_margin: float = field(default=0.25)  # the drone's radius
 
@@ -88,9 +89,12 @@ def _rng(name: str, seed: int) -> np.random.Generator:
     return np.random.default_rng([zlib.crc32(name.encode()), seed])
 
 
-def make_scenario(name: str, seed: int, *, noise: bool = True, marker: bool = True) -> Scenario:
+def make_scenario(
+    name: str, seed: int, *, noise: bool = True, marker: bool = True, max_wind: float = 0.0
+) -> Scenario:
     """A named scenario; ``seed`` varies the start pose, the target's bearing, distance and height,
-    the lighting and the noise within the scenario's definition."""
+    with ``noise`` the lighting and the pixel noise, and with ``max_wind`` (m/s) a steady wind up to it
+    (off by default: the pilot has no position hold while the target is out of sight, see README)."""
     if name not in SCENARIOS:
         raise ConfigError(f"unknown scenario {name!r}; known: {', '.join(SCENARIOS)}")
     rng = _rng(name, seed)
@@ -143,6 +147,8 @@ def make_scenario(name: str, seed: int, *, noise: bool = True, marker: bool = Tr
     if name == "hidden":
         start = float(rng.uniform(8.0, 11.0))
         hidden = (Interval(start, start + float(rng.uniform(1.5, 3.0))),)
+    wind_speed = float(rng.uniform(0.0, 1.0)) * max_wind
+    wind_dir = float(rng.uniform(-math.pi, math.pi))
     return Scenario(
         name=name,
         seed=seed,
@@ -155,4 +161,5 @@ def make_scenario(name: str, seed: int, *, noise: bool = True, marker: bool = Tr
         light_gain=float(rng.uniform(0.75, 1.2)) if noise else 1.0,
         light_wobble=float(rng.uniform(0.0, 0.15)) if noise else 0.0,
         noise_sigma=float(rng.uniform(2.0, 6.0)) if noise else 0.0,
+        wind=(wind_speed * math.cos(wind_dir), wind_speed * math.sin(wind_dir)),
     )

@@ -51,7 +51,7 @@ class SimWorld:
         self.vd = vd
         self.camera_model = camera or CameraModel()
         self.renderer = Renderer(scenario, self.camera_model)
-        self.model = DroneModel(scenario.room, scenario.start, StickCentres.from_protocol(), params)
+        self.model = DroneModel(scenario.room, scenario.start, StickCentres.from_protocol(), params, scenario.wind)
         self.tick_ms = tick_ms
         self.substep_ms = substep_ms
         self.reach_m = reach_m
