@@ -596,7 +596,7 @@ class StreamDecoder:
     def __init__(self, time_fn: Callable[[], float] = time.monotonic) -> None:
         self._time_fn = time_fn
         self._buffer = bytearray()
-        self._last = 0.0
+        self._last_ms = 0
         self._errors: dict[ErrorKind, int] = dict.fromkeys(ErrorKind, 0)
 
     @property
@@ -616,11 +616,14 @@ class StreamDecoder:
         if now is None:
             now = self._time_fn()
         buffer = self._buffer
-        if buffer and data and (now - self._last) * 1000.0 > INTER_BYTE_TIMEOUT_MS:
+        # Whole milliseconds, as the Arduino counts them: a float difference would put a gap of exactly
+        # INTER_BYTE_TIMEOUT_MS on either side of the limit depending on the clock's magnitude.
+        now_ms = round(now * 1000.0)
+        if buffer and data and now_ms - self._last_ms > INTER_BYTE_TIMEOUT_MS:
             self._errors[ErrorKind.TIMEOUT] += 1
             buffer.clear()
         if data:
-            self._last = now
+            self._last_ms = now_ms
         out: list[Command] = []
         i, n = 0, len(data)
         while i < n:
