@@ -1,6 +1,9 @@
 #include "drone_app.h"
 
 #include <Arduino.h>
+#ifdef __AVR__
+#include <avr/sleep.h>
+#endif
 
 #include "pins.h"
 #include "pulse_out.h"
@@ -70,6 +73,25 @@ void apply_outputs() {
   widths_pending = !pulse_out::update(w);
 }
 
+// Sleep until the next interrupt when no byte waits: a received byte, the
+// millis() tick (every 1.024 ms) or a pulse edge wakes the loop again, so no
+// deadline slips by more than a tick. Saves power, and lets the simulator
+// skip the idle time. SEI's one-instruction delay makes check-then-sleep
+// race-free: a byte arriving after the check still wakes the CPU.
+void idle() {
+#ifdef __AVR__
+  set_sleep_mode(SLEEP_MODE_IDLE);
+  cli();
+  if (Serial.available() == 0) {
+    sleep_enable();
+    sei();
+    sleep_cpu();
+    sleep_disable();
+  }
+  sei();
+#endif
+}
+
 }  // namespace
 
 const drone::Drone& logic() { return the_drone; }
@@ -117,6 +139,7 @@ void loop() {
 #ifdef DRONE_BENCH_PIN
   if (busy) bench_mark();
 #endif
+  idle();
 }
 
 }  // namespace drone_app

@@ -71,6 +71,7 @@ Drone::Drone(Transmit tx)
       state_since_ms_(0),
       last_frame_ms_(0),
       result_(dp::Error::None),
+      last_parser_error_(dp::Error::None),
       test_step_(0),
       laser_before_test_(false),
       replies_dropped_(0) {}
@@ -90,6 +91,7 @@ void Drone::begin(uint32_t now_ms) {
 }
 
 void Drone::reply(const char* line, uint8_t length) {
+  last_parser_error_ = dp::Error::None;
   if (!tx_(line, length)) ++replies_dropped_;
 }
 
@@ -101,10 +103,14 @@ void Drone::receive(uint8_t byte, uint32_t now_ms) {
   DRONE_PARSER_MARK();
   if (complete) {
     execute(parser_.command(), now_ms);
-  } else if (parser_.last_error() != dp::Error::None) {
+  } else if (parser_.last_error() != dp::Error::None && parser_.last_error() != last_parser_error_) {
     // A malformed or timed-out frame: tell the Pi, change nothing else. It
-    // does not count as a sign of life for the failsafe.
-    reply(line, dp::write_rejected(parser_.last_error(), line));
+    // does not count as a sign of life for the failsafe. A burst of garbage
+    // is answered once per kind of error (the parser counts every byte), so
+    // noise cannot fill the transmit buffer ahead of real replies.
+    const dp::Error e = parser_.last_error();
+    reply(line, dp::write_rejected(e, line));
+    last_parser_error_ = e;
   }
 }
 

@@ -84,7 +84,8 @@ class Drone {
   uint32_t now_ms_;
   uint32_t state_since_ms_;
   uint32_t last_frame_ms_;
-  dp::Error result_;  // set by the handler that dispatch() picked
+  dp::Error result_;             // set by the handler that dispatch() picked
+  dp::Error last_parser_error_;  // the last reply, if it reported this parser error
   uint8_t test_step_;
   bool laser_before_test_;
   uint16_t replies_dropped_;

@@ -332,22 +332,38 @@ def test_self_test_is_refused_when_armed() -> None:
     assert [c for c in trace.changes if c["t_ms"] >= t0] == []
 
 
-def test_replies_never_block_a_flood_of_garbage_drops_replies_and_counts_them() -> None:
+def test_a_burst_of_garbage_is_answered_once_and_does_not_delay_the_next_reply() -> None:
     garbage = bytes(range(0x80, 0x80 + 60)) * 10  # 600 bytes that are no category: one error each
     script = fw.Script().arm()
     t0 = script.t_ms
     for i in range(0, len(garbage), 50):
         script.send(garbage[i : i + 50]).step(5)
-    trace = script.step(60).send(dp.move_up(1621)).step(5).stats().run()
+    t1 = script.t_ms
+    trace = script.send(dp.move_up(1621)).step(5).stats().run()
+    assert trace.stats[-1]["errors"]["bad_category"] == len(garbage)  # every byte counted...
+    assert trace.replies(since_ms=t0) == [rejected(dp.ErrorKind.BAD_CATEGORY), accepted(dp.move_up(1621))]
+    (t_reply,) = [t for t, text in trace.tx if t >= t1]
+    assert t_reply == t1 + 1  # ...and answered once, so the next frame's reply leaves at once
+
+
+def test_replies_never_block_when_the_transmit_buffer_is_full_they_are_dropped_and_counted() -> None:
+    # Alternating error kinds ("mfX": bad digit, "Z": bad category) ask for 6 reply bytes per 4 bytes received:
+    # more than the line can send, so the transmit buffer fills.
+    noise = b"mfXZ" * 150
+    script = fw.Script().arm()
+    t0 = script.t_ms
+    for i in range(0, len(noise), 40):
+        script.send(noise[i : i + 40]).step(4)
+    script.step(60)
+    t1 = script.t_ms
+    trace = script.send(dp.move_up(1621)).step(5).stats().run()
     stats = trace.stats[-1]
-    errors = trace.replies(since_ms=t0)
-    assert stats["errors"]["bad_category"] == len(garbage)
-    assert stats["replies_dropped"] > 0  # 3-byte replies to bytes arriving at the same rate overflow the buffer
-    assert (
-        len([r for r in errors if r == rejected(dp.ErrorKind.BAD_CATEGORY)]) == len(garbage) - stats["replies_dropped"]
-    )
-    # the loop kept running: the next frame is served on time
-    assert trace.first_change(since_ms=t0, state="moving")["throttle"] == 1621
+    assert stats["errors"]["bad_digit"] == 150 and stats["errors"]["bad_category"] >= 150
+    sent = trace.replies(since_ms=t0)
+    assert stats["replies_dropped"] > 0
+    assert len(sent) - 1 + stats["replies_dropped"] == 300  # every reply either sent or counted as dropped
+    # the loop was never held up: the next frame is served on time
+    assert trace.first_change(since_ms=t1, state="moving")["t_ms"] == t1 + 1
 
 
 @settings(max_examples=25, deadline=None)
