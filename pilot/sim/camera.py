@@ -104,6 +104,7 @@ class Renderer:
             for a, b in zip(corners, corners[1:] + corners[:1], strict=True)
         ]
         self._bits = marker_bits(scenario.marker) if scenario.marker is not None else None
+        self._black = np.nonzero(self._bits) if self._bits is not None else (np.zeros(0, np.intp),) * 2
         rng = np.random.default_rng([scenario.seed, 0x5EED])
         self._noise: list[tuple[Image, Image]] = []
         if scenario.noise_sigma > 0:
@@ -256,8 +257,7 @@ class Renderer:
             + ((half - is_ * cell)[..., None]) * up
         )
         uv = self._project(self._to_camera(pose, grid.reshape(-1, 3))).reshape(n + 1, n + 1, 2)
-        for i in range(n):
-            for j in range(n):
-                if self._bits[i, j]:
-                    quad = np.array([uv[i, j], uv[i, j + 1], uv[i + 1, j + 1], uv[i + 1, j]])
-                    self._fill(img, quad, (20, 20, 20))
+        i, j = self._black
+        quads = np.stack([uv[i, j], uv[i, j + 1], uv[i + 1, j + 1], uv[i + 1, j]], axis=1)  # (cells, 4, 2)
+        pts = np.round(quads * ONE).astype(np.int32)
+        cv2.fillPoly(img, list(pts), (20, 20, 20), cv2.LINE_8, SHIFT)

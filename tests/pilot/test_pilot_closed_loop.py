@@ -16,7 +16,10 @@ from pilot.sim.flight import SUCCESS_LIT_MS, FlightJob, FlightResult, fly, fly_m
 from pilot.sim.room import SCENARIOS, make_scenario
 
 SEEDS = range(20)
-ARUCO_SCENARIOS = ("ahead",)
+# The ArUco path flies at 640x480 (the plate is too few pixels at 320x240 from 5 m) and its detector
+# costs ~2.7 ms a frame: a smaller set of seeds checks that it flies, the HSV sets carry the statistics.
+ARUCO_SCENARIOS = ("ahead", "side")
+ARUCO_SEEDS = range(5)
 REQUIRED = 0.95
 
 
@@ -26,7 +29,7 @@ def flights(virtual_drone: Path) -> dict[tuple[str, str], list[FlightResult]]:
     jobs += [
         FlightJob(name, seed, "aruco", width=640, height=480, executable=str(virtual_drone))
         for name in ARUCO_SCENARIOS
-        for seed in SEEDS
+        for seed in ARUCO_SEEDS
     ]
     results = fly_many(jobs, processes=2)
     by: dict[tuple[str, str], list[FlightResult]] = defaultdict(list)
@@ -44,7 +47,7 @@ def test_scenario_reaches_and_lights_the_target(
     detector: str, scenario: str, flights: dict[tuple[str, str], list[FlightResult]]
 ) -> None:
     results = flights[(detector, scenario)]
-    assert len(results) == len(SEEDS)
+    assert len(results) == len(SEEDS if detector == "hsv" else ARUCO_SEEDS)
     ok = [r for r in results if r.success]
     failures = "\n".join(r.summary() for r in results if not r.success)
     assert len(ok) >= math.ceil(REQUIRED * len(results)), f"{len(ok)}/{len(results)} succeeded:\n{failures}"
@@ -66,7 +69,7 @@ def test_scenario_never_hits_a_wall_or_crashes(
 
 def test_every_flight_ends_landed_and_disarmed(flights: dict[tuple[str, str], list[FlightResult]]) -> None:
     everything = [r for rs in flights.values() for r in rs]
-    assert len(everything) == len(CASES) * len(SEEDS)
+    assert len(everything) == len(SCENARIOS) * len(SEEDS) + len(ARUCO_SCENARIOS) * len(ARUCO_SEEDS)
     assert all(r.final_state == "done" for r in everything)
 
 
