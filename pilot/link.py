@@ -85,7 +85,8 @@ class Link:
         self.wait_ready = wait_ready
         self._clock = clock
         self._sleep = sleep
-        # the ready-line wait may use its own clock (the simulator waits for the kernel, not for sim time)
+        # waiting for the ready line and reopening a lost port may use their own clock: the simulator
+        # waits for the kernel there, not for simulated time
         self._ready_clock = ready_clock or clock
         self._ready_sleep = ready_sleep or sleep
         self._log = log
@@ -216,13 +217,13 @@ class Link:
         if self._url is None:
             raise LinkError(f"link {self.name!r}: the port failed and this link cannot reopen it")
         self._close_port()
-        deadline = self._clock() + self.reconnect_s
+        deadline = self._ready_clock() + self.reconnect_s
         delay = 0.05
-        while self._clock() < deadline:
+        while self._ready_clock() < deadline:
             try:
                 self._open_port()
                 if self.wait_ready:
-                    self.await_ready(timeout_s=max(0.1, deadline - self._clock()))
+                    self.await_ready(timeout_s=max(0.1, deadline - self._ready_clock()))
                 self.reconnects += 1
                 self._note("link", f"reopened {self.name} (reconnect {self.reconnects})")
                 return True
@@ -231,7 +232,7 @@ class Link:
             except LinkError as exc:
                 self._note("link", f"reopen failed: {exc}")
                 self._close_port()
-                self._sleep(delay)
+                self._ready_sleep(delay)
                 delay = min(0.5, delay * 2)
         raise LinkError(f"link {self.name!r}: lost and not back within {self.reconnect_s:.1f} s")
 

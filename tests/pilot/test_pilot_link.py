@@ -241,8 +241,8 @@ def test_reconnect_gives_up_after_its_time_with_a_clear_error() -> None:
     clock = FakeClock()
     link = Link(f"socket://127.0.0.1:{server.port}", reconnect_s=1.0, ready_timeout_s=5.0)
     link.open()
-    link._clock = clock  # reconnect attempts on the injected clock from here on
-    link._sleep = clock.sleep
+    link._ready_clock = clock  # reconnect attempts on the injected clock from here on
+    link._ready_sleep = clock.sleep
     server.close()  # gone for good
     with pytest.raises(LinkError, match=r"not back within 1\.0 s"):
         for _ in range(100):
