@@ -39,46 +39,60 @@ FW_CORE_C := $(wildcard $(ARDUINO_CORE)/*.c)
 FW_CORE_CXX := $(wildcard $(ARDUINO_CORE)/*.cpp)
 FW_CORE_S := $(wildcard $(ARDUINO_CORE)/*.S)
 
-# $(call fw_board,NAME,MCU,VARIANT,BOARD_DEFINE,EXTRA_DEFINES,SKETCH_SOURCES)
-# Builds $(FW_BUILD)/NAME/NAME.elf/.hex from the Arduino core and the sources.
-define fw_board
-FW_$(1)_DIR := $$(FW_BUILD)/$(1)
-FW_$(1)_FLAGS := -mmcu=$(2) $$(FW_AVR_COMMON) -DARDUINO_$(4) $(5) -I$$(ARDUINO_CORE) -I$$(ARDUINO_AVR)/variants/$(3)
-FW_$(1)_CORE_OBJ := $$(patsubst $$(ARDUINO_CORE)/%,$$(FW_$(1)_DIR)/core/%.o,$$(FW_CORE_C) $$(FW_CORE_CXX) $$(FW_CORE_S))
+# The Arduino core, built once per board type and shared by every build for
+# it (the sketch's own defines do not reach the core). FW_CORE_BUILD may point
+# elsewhere than FW_BUILD so that a temporary build reuses the cores.
+FW_CORE_BUILD ?= $(FW_BUILD)
 
-$$(FW_$(1)_DIR)/core/%.c.o: $$(ARDUINO_CORE)/%.c
+# $(call fw_core,KEY,MCU,VARIANT,BOARD_DEFINE) -> $(FW_CORE_BUILD)/core_KEY/core.a
+define fw_core
+FW_CORE_$(1)_DIR := $$(FW_CORE_BUILD)/core_$(1)
+FW_CORE_$(1)_FLAGS := -mmcu=$(2) $$(FW_AVR_COMMON) -DARDUINO_$(4) -I$$(ARDUINO_CORE) -I$$(ARDUINO_AVR)/variants/$(3)
+FW_CORE_$(1)_OBJ := $$(patsubst $$(ARDUINO_CORE)/%,$$(FW_CORE_$(1)_DIR)/%.o,$$(FW_CORE_C) $$(FW_CORE_CXX) $$(FW_CORE_S))
+
+$$(FW_CORE_$(1)_DIR)/%.c.o: $$(ARDUINO_CORE)/%.c
 	@mkdir -p $$(@D)
-	@$$(AVR_CC) -c -w $$(FW_$(1)_FLAGS) $$(FW_AVR_CFLAGS) $$< -o $$@
-$$(FW_$(1)_DIR)/core/%.cpp.o: $$(ARDUINO_CORE)/%.cpp
+	@$$(AVR_CC) -c -w $$(FW_CORE_$(1)_FLAGS) $$(FW_AVR_CFLAGS) $$< -o $$@
+$$(FW_CORE_$(1)_DIR)/%.cpp.o: $$(ARDUINO_CORE)/%.cpp
 	@mkdir -p $$(@D)
-	@$$(AVR_CXX) -c -w $$(FW_$(1)_FLAGS) $$(FW_AVR_CXXFLAGS) $$< -o $$@
-$$(FW_$(1)_DIR)/core/%.S.o: $$(ARDUINO_CORE)/%.S
+	@$$(AVR_CXX) -c -w $$(FW_CORE_$(1)_FLAGS) $$(FW_AVR_CXXFLAGS) $$< -o $$@
+$$(FW_CORE_$(1)_DIR)/%.S.o: $$(ARDUINO_CORE)/%.S
 	@mkdir -p $$(@D)
-	@$$(AVR_CC) -c -x assembler-with-cpp $$(FW_$(1)_FLAGS) $$< -o $$@
-$$(FW_$(1)_DIR)/core.a: $$(FW_$(1)_CORE_OBJ)
+	@$$(AVR_CC) -c -x assembler-with-cpp $$(FW_CORE_$(1)_FLAGS) $$< -o $$@
+$$(FW_CORE_$(1)_DIR)/core.a: $$(FW_CORE_$(1)_OBJ)
 	@rm -f $$@
 	@echo "  AR    $$@ (Arduino core)"
 	@avr-gcc-ar rcs $$@ $$^
+endef
+
+$(eval $(call fw_core,uno,atmega328p,standard,AVR_UNO))
+$(eval $(call fw_core,mega,atmega2560,mega,AVR_MEGA2560))
+
+# $(call fw_board,NAME,CORE_KEY,EXTRA_DEFINES,SKETCH_SOURCES)
+# Builds $(FW_BUILD)/NAME/NAME.elf/.hex from a core and the sources.
+define fw_board
+FW_$(1)_DIR := $$(FW_BUILD)/$(1)
+FW_$(1)_FLAGS := $$(FW_CORE_$(2)_FLAGS) $(3)
 
 # The sketch and the generated library are compiled in one command with
 # -Werror: they are small, and this keeps the rule independent of how many
 # .cpp files the generator emits.
-$$(FW_$(1)_DIR)/$(1).elf: $(6) $$(FW_HEADERS) $$(FW_PROTO_SRC) $$(FW_PROTO_HDR) $$(FW_$(1)_DIR)/core.a
+$$(FW_$(1)_DIR)/$(1).elf: $(4) $$(FW_HEADERS) $$(FW_PROTO_SRC) $$(FW_PROTO_HDR) $$(FW_CORE_$(2)_DIR)/core.a
 	@mkdir -p $$(@D)
 	@test -f $$(DRONE_PROTOCOL_DIR)/src/DroneProtocol.h || { echo "missing $$(DRONE_PROTOCOL_DIR)/src/DroneProtocol.h: run the generator first" >&2; exit 1; }
 	@echo "  LD    $$@"
 	@$$(AVR_CXX) $$(FW_$(1)_FLAGS) $$(FW_AVR_CXXFLAGS) $$(FW_WARN) -fuse-linker-plugin -Wl,--gc-sections \
 	  -I$$(DRONE_PROTOCOL_DIR)/src -I$$(FW_DIR)/drone \
-	  -x c++ -include Arduino.h $$(filter %.ino,$(6)) -x none $$(filter-out %.ino,$(6)) $$(FW_PROTO_SRC) \
-	  $$(FW_$(1)_DIR)/core.a -lm -o $$@
+	  -x c++ -include Arduino.h $$(filter %.ino,$(4)) -x none $$(filter-out %.ino,$(4)) $$(FW_PROTO_SRC) \
+	  $$(FW_CORE_$(2)_DIR)/core.a -lm -o $$@
 $$(FW_$(1)_DIR)/$(1).hex: $$(FW_$(1)_DIR)/$(1).elf
 	@$$(AVR_OBJCOPY) -O ihex -R .eeprom $$< $$@
 endef
 
 FW_DRONE_SRC := $(FW_DIR)/drone/drone.ino $(FW_SKETCH_SRC)
-$(eval $(call fw_board,uno,atmega328p,standard,AVR_UNO,,$(FW_DRONE_SRC)))
-$(eval $(call fw_board,mega,atmega2560,mega,AVR_MEGA2560,,$(FW_DRONE_SRC)))
-$(eval $(call fw_board,uno_ppm,atmega328p,standard,AVR_UNO,-DDRONE_PPM,$(FW_DRONE_SRC)))
+$(eval $(call fw_board,uno,uno,,$(FW_DRONE_SRC)))
+$(eval $(call fw_board,mega,mega,,$(FW_DRONE_SRC)))
+$(eval $(call fw_board,uno_ppm,uno,-DDRONE_PPM,$(FW_DRONE_SRC)))
 
 FW_ELVES := $(FW_BUILD)/uno/uno.elf $(FW_BUILD)/mega/mega.elf $(FW_BUILD)/uno_ppm/uno_ppm.elf
 FW_HEXES := $(FW_ELVES:.elf=.hex)

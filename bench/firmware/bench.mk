@@ -8,12 +8,12 @@ FW_BENCH_PIN := -DDRONE_BENCH_PIN=7
 FW_BASELINE_SRC := bench/firmware/baseline/baseline.ino $(FW_DIR)/drone/pulse_out_avr.cpp \
                    $(FW_DIR)/drone/pulse_schedule.cpp
 
-$(eval $(call fw_board,uno_bench,atmega328p,standard,AVR_UNO,$(FW_BENCH_PIN),$(FW_DRONE_SRC)))
-$(eval $(call fw_board,uno_bench_nolead,atmega328p,standard,AVR_UNO,$(FW_BENCH_PIN) -DDRONE_PULSE_LEAD_US=0,$(FW_DRONE_SRC)))
-$(eval $(call fw_board,baseline,atmega328p,standard,AVR_UNO,,$(FW_BASELINE_SRC)))
-$(eval $(call fw_board,baseline_bench,atmega328p,standard,AVR_UNO,$(FW_BENCH_PIN),$(FW_BASELINE_SRC)))
-$(eval $(call fw_board,uno_bench_parser,atmega328p,standard,AVR_UNO,-DDRONE_BENCH_PARSER_PIN=7,$(FW_DRONE_SRC)))
-$(eval $(call fw_board,baseline_bench_parser,atmega328p,standard,AVR_UNO,-DDRONE_BENCH_PARSER_PIN=7,$(FW_BASELINE_SRC)))
+$(eval $(call fw_board,uno_bench,uno,$(FW_BENCH_PIN),$(FW_DRONE_SRC)))
+$(eval $(call fw_board,uno_bench_nolead,uno,$(FW_BENCH_PIN) -DDRONE_PULSE_LEAD_US=0,$(FW_DRONE_SRC)))
+$(eval $(call fw_board,baseline,uno,,$(FW_BASELINE_SRC)))
+$(eval $(call fw_board,baseline_bench,uno,$(FW_BENCH_PIN),$(FW_BASELINE_SRC)))
+$(eval $(call fw_board,uno_bench_parser,uno,-DDRONE_BENCH_PARSER_PIN=7,$(FW_DRONE_SRC)))
+$(eval $(call fw_board,baseline_bench_parser,uno,-DDRONE_BENCH_PARSER_PIN=7,$(FW_BASELINE_SRC)))
 
 FW_BENCH_BOARDS := uno uno_bench uno_bench_nolead uno_bench_parser baseline baseline_bench baseline_bench_parser
 FW_BENCH_ELVES := $(foreach b,$(FW_BENCH_BOARDS),$(FW_BUILD)/$(b)/$(b).elf)
