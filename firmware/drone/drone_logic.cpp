@@ -9,9 +9,25 @@ void drone_bench_parser_mark();
 #define DRONE_PARSER_MARK()
 #endif
 
+#ifdef __AVR__
+#include <avr/pgmspace.h>
+#define DRONE_FLASH PROGMEM
+#else
+#define DRONE_FLASH
+#endif
+
 namespace drone {
 
 namespace {
+
+// Constant tables live in flash on the AVR (RAM is 2 KB), in memory on the host.
+uint8_t flash_byte(const void* p) {
+#ifdef __AVR__
+  return pgm_read_byte(p);
+#else
+  return *static_cast<const uint8_t*>(p);
+#endif
+}
 
 // Self-test choreography: one step per SELF_TEST_STEP_MS. This is a bench
 // routine of the firmware, not part of the wire protocol, so its timing is
@@ -21,7 +37,8 @@ struct TestStep {
   dp::Target target;  // None = the laser
   int8_t level;       // -1 low / minimum, 0 neutral / default, +1 high / maximum; laser: 1 on, 0 off
 };
-const TestStep kSelfTest[] = {
+static_assert(sizeof(dp::Target) == 1, "TestStep is read from flash byte by byte");
+const TestStep kSelfTest[] DRONE_FLASH = {
     {dp::Target::Pan, -1},  {dp::Target::Pan, 1},   {dp::Target::Pan, 0},  {dp::Target::Tilt, -1},
     {dp::Target::Tilt, 1},  {dp::Target::Tilt, 0},  {dp::Target::None, 1}, {dp::Target::None, 0},
     {dp::Target::None, 1},  {dp::Target::None, 0},  {dp::Target::Roll, -1}, {dp::Target::Roll, 1},
@@ -29,6 +46,7 @@ const TestStep kSelfTest[] = {
     {dp::Target::Yaw, -1},  {dp::Target::Yaw, 1},   {dp::Target::Yaw, 0},
 };
 constexpr uint8_t SELF_TEST_STEPS = sizeof(kSelfTest) / sizeof(kSelfTest[0]);
+static_assert(sizeof(kSelfTest) / sizeof(kSelfTest[0]) < 256, "steps are counted in a uint8_t");
 
 uint16_t clamp16(int32_t v, uint16_t lo, uint16_t hi) {
   return v < lo ? lo : (v > hi ? hi : static_cast<uint16_t>(v));
@@ -199,7 +217,9 @@ void Drone::enter_failsafe() {
 }
 
 void Drone::self_test_step(uint8_t step) {
-  const TestStep& s = kSelfTest[step];
+  TestStep s;
+  s.target = static_cast<dp::Target>(flash_byte(&kSelfTest[step].target));
+  s.level = static_cast<int8_t>(flash_byte(&kSelfTest[step].level));
   switch (s.target) {
     case dp::Target::None:
       out_.laser = s.level != 0;

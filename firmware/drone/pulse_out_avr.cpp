@@ -5,13 +5,14 @@
 
 #include <Arduino.h>
 #include <avr/interrupt.h>
+#include <avr/pgmspace.h>
 
 #include "pins.h"
 #include "pulse_out.h"
 
 namespace {
 
-const uint8_t kPins[pulse::LINE_COUNT] = {pins::ROLL, pins::PITCH, pins::THROTTLE, pins::YAW,
+const uint8_t kPins[pulse::LINE_COUNT] PROGMEM = {pins::ROLL, pins::PITCH, pins::THROTTLE, pins::YAW,
                                           pins::MODE, pins::PAN,   pins::TILT,     pins::PPM};
 // Edges are made by writing the bit mask to the pin's PINx register, which
 // toggles it in one store: no read-modify-write, so the lowering and the
@@ -79,10 +80,11 @@ namespace pulse_out {
 
 void begin(const uint16_t width_us[pulse::OUTPUTS]) {
   for (uint8_t i = 0; i < pulse::LINE_COUNT; ++i) {
-    pinMode(kPins[i], OUTPUT);
-    digitalWrite(kPins[i], LOW);
-    toggle_reg[i] = portInputRegister(digitalPinToPort(kPins[i]));
-    toggle_mask[i] = digitalPinToBitMask(kPins[i]);
+    const uint8_t pin = pgm_read_byte(&kPins[i]);
+    pinMode(pin, OUTPUT);
+    digitalWrite(pin, LOW);
+    toggle_reg[i] = portInputRegister(digitalPinToPort(pin));
+    toggle_mask[i] = digitalPinToBitMask(pin);
   }
   toggle_reg[pulse::NO_LINE] = toggle_reg[0];
   toggle_mask[pulse::NO_LINE] = 0;  // writing 0 to PINx toggles nothing
