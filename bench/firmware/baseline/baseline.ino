@@ -28,7 +28,9 @@ uint16_t servo_us(int deg) { return 544 + (deg * (2400L - 544) + 90) / 180; }
 #define MARK_PIN DRONE_BENCH_PARSER_PIN
 #endif
 #ifdef MARK_PIN
-void bench_mark() { *portInputRegister(digitalPinToPort(MARK_PIN)) = digitalPinToBitMask(MARK_PIN); }
+volatile uint8_t* mark_reg;
+uint8_t mark_mask;
+void bench_mark() { *mark_reg = mark_mask; }
 #endif
 
 }  // namespace
@@ -39,6 +41,12 @@ void setup() {
   pinMode(pins::LASER, OUTPUT);
 #ifdef MARK_PIN
   pinMode(MARK_PIN, OUTPUT);
+  mark_reg = portInputRegister(digitalPinToPort(MARK_PIN));
+  mark_mask = digitalPinToBitMask(MARK_PIN);
+  for (uint8_t i = 0; i < 8; ++i) {  // calibration: empty marked spans
+    bench_mark();
+    bench_mark();
+  }
 #endif
   pulse_out::begin(widths);
 }
