@@ -30,7 +30,7 @@ from __future__ import annotations
 import enum
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import drone_protocol as dp
@@ -98,6 +98,7 @@ class Controller:
         self._fire_started_ms = 0
         self._laser_since_ms = 0
         self._sent_entry = False
+        self._airborne_at_abort = False
         self._pan_offset = 0  # degrees the pilot has moved the pan servo from its default
         self._tilt_offset = 0
         tan_h = math.tan(math.radians(self.cfg.horizontal_fov_deg) / 2.0)
@@ -160,22 +161,28 @@ class Controller:
             self._go(State.LAND, "firmware says not armed")
 
     def abort(self, reason: str) -> None:
-        """Stop the mission: the caller then sends ``safe_sequence()``."""
+        """Stop the mission: the caller then sends ``safe_steps()``."""
+        self._airborne_at_abort = self.state in FLYING or self.state is State.LAND
         if self.state not in (State.DONE, State.IDLE):
             self._go(State.DONE, f"abort: {reason}")
 
-    def safe_sequence(self) -> list[bytes]:
-        """Laser off, sticks neutral, servos home, land, disarm: what goes on the wire before exit."""
-        frames: list[bytes] = []
+    def safe_steps(self) -> Iterator[bytes]:
+        """What goes on the wire before exit, one frame per tick: laser off (if on), sticks neutral,
+        servos home; if it was flying, down for ``land_ms`` (the flight controller disarms only on the
+        ground, after the sticks are held there); then disarm. Timed on the injected clock."""
         off = self._laser(False)
         if off is not None:
-            frames.append(off)
-        frames.append(dp.hold_altitude())
-        frames.append(dp.servo_reset())
-        frames.append(dp.move_down(_speed("move_down", 1.0)))
-        frames.append(dp.disarm())
-        self.last_command = frames[-1]
-        return frames
+            yield off
+        yield self._emit(dp.hold_altitude())
+        self._pan_offset = self._tilt_offset = 0
+        yield self._emit(dp.servo_reset())
+        if self._airborne_at_abort:
+            start = self._now()
+            for _ in range(self.cfg.land_ms // 5 + 1):  # bounded even if the clock stands still
+                if self._now() - start >= self.cfg.land_ms:
+                    break
+                yield self._emit(dp.move_down(_speed("move_down", 1.5)))
+        yield self._emit(dp.disarm())
 
     # -- the state machine -----------------------------------------------------------------------
     def update(self, det: Detection | None) -> bytes | None:

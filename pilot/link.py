@@ -76,6 +76,7 @@ class Link:
         log: Callable[[LogEntry], None] | None = None,
         ready_clock: Callable[[], float] | None = None,
         ready_sleep: Callable[[float], None] | None = None,
+        on_open: Callable[[], None] | None = None,
     ) -> None:
         self._url = port if isinstance(port, str) else None
         self._port: Any = None if isinstance(port, str) else port
@@ -90,6 +91,9 @@ class Link:
         self._ready_clock = ready_clock or clock
         self._ready_sleep = ready_sleep or sleep
         self._log = log
+        # called after every (re)opening of the port, before the ready-line wait: the simulator runs
+        # the virtual board's reboot there (opening the port resets it, as DTR resets an Uno)
+        self._on_open = on_open
         self._buffer = bytearray()
         self._closed = False
         self._opened = False
@@ -126,6 +130,8 @@ class Link:
         self._open_port()
         self._opened = True
         self._note("link", f"opened {self.name}")
+        if self._on_open is not None:
+            self._on_open()
         if self.wait_ready:
             self.await_ready()
         return self
@@ -222,6 +228,8 @@ class Link:
         while self._ready_clock() < deadline:
             try:
                 self._open_port()
+                if self._on_open is not None:
+                    self._on_open()
                 if self.wait_ready:
                     self.await_ready(timeout_s=max(0.1, deadline - self._ready_clock()))
                 self.reconnects += 1

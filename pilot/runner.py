@@ -5,9 +5,9 @@ one (the simulated camera, the virtual drone's pty, the world's stepped clock as
 
 Safety: whatever ends the loop — the mission done, the time limit, the end of a video, a lost camera,
 Ctrl-C/SIGTERM (``KeyboardInterrupt``), or an exception in any stage (source, detector, controller,
-link, observers) — the controller's safe sequence goes on the wire before ``run`` returns: laser off
-(if on), sticks neutral, servos home, down, disarm; then keep-alives while the firmware's disarm
-sequence runs.
+link, observers) — the controller's safe steps go on the wire before ``run`` returns, one per tick:
+laser off (if on), sticks neutral, servos home, down until landed (if it was flying), disarm; then
+keep-alives while the firmware's disarm sequence runs.
 """
 
 from __future__ import annotations
@@ -229,7 +229,7 @@ def _shutdown(controller: Controller, sink: Sink, pacer: Pacer, keepalive_ms: in
     def sender(frame: bytes) -> Callable[[], object]:
         return lambda: sink.send(frame)
 
-    for frame in controller.safe_sequence():
+    for frame in controller.safe_steps():
         result.safe_frames.append(frame)
         _guarded(result, f"send {frame!r}", sender(frame))
         _guarded(result, "poll", sink.poll)

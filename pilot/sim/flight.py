@@ -24,7 +24,7 @@ from pilot.runner import Observer, run
 from pilot.sim.camera import CameraModel
 from pilot.sim.room import make_scenario
 from pilot.sim.virtual import VirtualDrone
-from pilot.sim.world import SimWorld
+from pilot.sim.world import BOOT_MS, SimWorld
 
 SUCCESS_LIT_MS = 500  # laser on the target, within reach, for at least this long
 
@@ -49,7 +49,8 @@ class FlightResult:
     frames_sent: int
     reconnects: int
     final_laser: bool  # the virtual drone's laser pin at the end
-    final_armed: bool
+    final_armed: bool  # the firmware's state
+    final_fc_armed: bool  # the flight controller's (the model's, from the sticks)
     final_altitude: float
     record_dir: str | None = None
     path_picture: str | None = None
@@ -125,9 +126,10 @@ def fly(
                 reconnect_s=cfg.link.reconnect_s,
                 clock=world.now,
                 log=link_log,
-                # the firmware has sent its ready line by now (SimWorld boots it for BOOT_MS); what is
-                # left is the kernel moving the bytes through the pty: wait for that in real time, so
-                # that the flight's simulated timeline does not depend on it
+                # opening the pty reboots the virtual board: run it for BOOT_MS (it sends its ready line
+                # well within), then wait in real time for the kernel to move the bytes through the pty,
+                # so that the flight's simulated timeline does not depend on that
+                on_open=lambda: world.advance(BOOT_MS),
                 ready_clock=time.monotonic,
                 ready_sleep=time.sleep,
             )
@@ -186,6 +188,7 @@ def fly(
                 reconnects=link.reconnects,
                 final_laser=world.outputs.laser,
                 final_armed=world.outputs.armed,
+                final_fc_armed=state.armed,
                 final_altitude=state.z,
                 record_dir=str(recorder.dir) if recorder is not None else None,
                 path_picture=picture,

@@ -1,7 +1,12 @@
 """A kinematic drone model driven by the RC pulses the virtual drone outputs.
 
 It stands in for ArduCopter plus the airframe, in the simplest form that still makes the pilot's
-job real. Each stick is read against its Table 4 median (taken from ``drone_protocol.CHANNELS``):
+job real. It reads the pulses only, as the flight controller does (not the firmware's own idea of
+being armed). Each stick is read against its Table 4 median (from ``drone_protocol.CHANNELS``):
+
+* arming, as ArduCopter's stick arming: on the ground, throttle at its minimum and yaw full right
+  (within ``stick_margin_us`` of the recorded extremes) held for ``arm_hold_s``; disarming: throttle
+  minimum and yaw full left for the same time, on the ground only (ArduCopter refuses it in flight);
 
 * a dead band of ``dead_band_us`` (default 12 µs) either side of the median is "centred";
 * pitch above its median flies forward, roll above its median slides right, throttle above its
@@ -13,7 +18,7 @@ job real. Each stick is read against its Table 4 median (taken from ``drone_prot
   a first-order lag (``tau_xy``, ``tau_z``, ``tau_yaw`` seconds);
 * throttle below the channel's recorded minimum (only the firmware's failsafe throttle goes there)
   descends at ``land_speed``;
-* disarmed: the motors stop; in the air it drops at ``drop_speed`` (a crash, counted);
+* disarmed: the motors stop; touching down faster than ``crash_speed`` counts as a crash;
 * airborne, the scenario's steady wind (none by default) drifts it;
 * the room's walls, floor and ceiling stop it: touching a wall (within ``radius`` of it) counts as a
   wall hit; the floor is where it lands.
@@ -34,6 +39,8 @@ class StickCentres:
     throttle: int
     yaw: int
     throttle_minimum: int  # the recorded minimum: below it only the failsafe's throttle goes
+    yaw_minimum: int
+    yaw_maximum: int
 
     @staticmethod
     def from_protocol() -> StickCentres:
@@ -46,6 +53,8 @@ class StickCentres:
             throttle=int(ch["throttle"].median),
             yaw=int(ch["yaw"].median),
             throttle_minimum=int(ch["throttle"].minimum),
+            yaw_minimum=int(ch["yaw"].minimum),
+            yaw_maximum=int(ch["yaw"].maximum),
         )
 
 
@@ -62,7 +71,9 @@ class ModelParams:
     tau_z: float = 0.25
     tau_yaw: float = 0.12
     land_speed: float = 0.8
-    drop_speed: float = 3.0
+    crash_speed: float = 2.0
+    stick_margin_us: float = 50.0
+    arm_hold_s: float = 1.5  # ArduCopter: about 2 s; shorter than the firmware's hold, so that it always suffices
     radius: float = 0.25
 
 
@@ -94,6 +105,9 @@ class DroneState:
     wall_hits: int = 0
     crashes: int = 0
     touching: bool = field(default=False)
+    armed: bool = False  # the flight controller's arming, from the sticks
+    arm_timer: float = 0.0
+    disarm_timer: float = 0.0
 
 
 class DroneModel:
@@ -119,12 +133,31 @@ class DroneModel:
             return 0.0
         return (off - math.copysign(band, off)) / 100.0
 
+    def _arming(self, out: Outputs, dt: float, airborne: bool) -> None:
+        p, s, c = self.p, self.state, self.centres
+        throttle_low = out.throttle <= c.throttle_minimum + p.stick_margin_us
+        yaw_right = out.yaw >= c.yaw_maximum - p.stick_margin_us
+        yaw_left = out.yaw <= c.yaw_minimum + p.stick_margin_us
+        if not airborne and throttle_low and yaw_right and not s.armed:
+            s.arm_timer += dt
+            if s.arm_timer >= p.arm_hold_s - 1e-9:
+                s.armed = True
+        else:
+            s.arm_timer = 0.0
+        if not airborne and throttle_low and yaw_left and s.armed:
+            s.disarm_timer += dt
+            if s.disarm_timer >= p.arm_hold_s - 1e-9:
+                s.armed = False
+        else:
+            s.disarm_timer = 0.0
+
     def step(self, out: Outputs, dt: float) -> None:
         p, s, c = self.p, self.state, self.centres
         airborne = s.z > 1e-6
-        if not out.armed:
+        self._arming(out, dt, airborne)
+        if not s.armed:
             want_f = want_r = want_yaw = 0.0
-            want_up = -p.drop_speed if airborne else 0.0
+            want_up = -2.0 * p.crash_speed if airborne else 0.0  # motors off in the air (only if forced): it falls
         else:
             want_f = max(-p.max_speed, min(p.max_speed, p.speed_per_100us * self._stick(out.pitch, c.pitch)))
             want_r = max(-p.max_speed, min(p.max_speed, p.speed_per_100us * self._stick(out.roll, c.roll)))
@@ -142,7 +175,7 @@ class DroneModel:
         a_yaw = 1.0 - math.exp(-dt / p.tau_yaw)
         s.v_forward += (want_f - s.v_forward) * a_xy
         s.v_right += (want_r - s.v_right) * a_xy
-        s.v_up += (want_up - s.v_up) * (1.0 if not out.armed else a_z)
+        s.v_up += (want_up - s.v_up) * (1.0 if not s.armed else a_z)
         s.yaw_rate += (want_yaw - s.yaw_rate) * a_yaw
         s.heading = (s.heading + s.yaw_rate * dt + math.pi) % (2.0 * math.pi) - math.pi
         ch, sh = math.cos(s.heading), math.sin(s.heading)
@@ -165,7 +198,7 @@ class DroneModel:
             nz = self.room.height - 0.1
             touching = True
         if nz <= 0.0:
-            if airborne and not out.armed:
+            if airborne and -s.v_up > p.crash_speed:
                 s.crashes += 1
             nz = 0.0
             s.v_up = 0.0

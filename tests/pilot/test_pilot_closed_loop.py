@@ -63,7 +63,8 @@ def test_scenario_never_hits_a_wall_or_crashes(
     for r in flights[(detector, scenario)]:
         assert r.wall_hits == 0, r.summary()
         assert r.crashes == 0, r.summary()
-        assert not r.final_laser and not r.final_armed and r.final_altitude == 0.0, r.summary()
+        assert not r.final_laser and not r.final_armed and not r.final_fc_armed, r.summary()
+        assert r.final_altitude == 0.0, r.summary()
         assert r.error is None, r.summary()
 
 

@@ -264,17 +264,46 @@ def test_busy_reply_during_arming_is_ignored() -> None:
     assert st(c) is State.ARM
 
 
-def test_safe_sequence_with_laser_on() -> None:
-    c, _clock = to_state(State.FIRE)
+def safe_names(c: Controller, clock: Clock, tick_ms: float = 50.0) -> list[str]:
+    out = []
+    for frame in c.safe_steps():
+        out.append(name(frame))
+        clock.advance_ms(tick_ms)
+    return out
+
+
+def test_safe_steps_with_laser_on_land_before_disarming() -> None:
+    c, clock = to_state(State.FIRE)
     c.abort("test")
-    frames = c.safe_sequence()
-    assert [name(f) for f in frames] == ["laser_toggle", "hold_altitude", "servo_reset", "move_down", "disarm"]
-    assert not c.laser_on and st(c) is State.DONE
+    assert st(c) is State.DONE
+    names = safe_names(c, clock)
+    assert names[:3] == ["laser_toggle", "hold_altitude", "servo_reset"]
+    assert names[-1] == "disarm"
+    downs = names[3:-1]
+    assert set(downs) == {"move_down"}
+    assert len(downs) == CFG.land_ms // 50  # down for the landing time, one frame per tick
+    assert not c.laser_on
 
 
-def test_safe_sequence_with_laser_off_has_no_toggle() -> None:
+def test_safe_steps_with_laser_off_have_no_toggle() -> None:
+    c, clock = to_state(State.TRACK)
+    c.abort("test")
+    names = safe_names(c, clock)
+    assert names[:2] == ["hold_altitude", "servo_reset"] and names[-1] == "disarm"
+    assert "laser_toggle" not in names
+
+
+def test_safe_steps_on_the_ground_disarm_at_once() -> None:
+    c, clock = to_state(State.ARM)
+    c.abort("test")
+    assert safe_names(c, clock) == ["hold_altitude", "servo_reset", "disarm"]
+
+
+def test_safe_steps_are_bounded_when_the_clock_stands_still() -> None:
     c, _clock = to_state(State.TRACK)
-    assert [name(f) for f in c.safe_sequence()] == ["hold_altitude", "servo_reset", "move_down", "disarm"]
+    c.abort("test")
+    names = [name(f) for f in c.safe_steps()]  # the clock never advances
+    assert names[-1] == "disarm" and len(names) <= CFG.land_ms // 5 + 4
 
 
 def test_config_changes_take_effect() -> None:

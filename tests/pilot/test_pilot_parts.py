@@ -183,7 +183,7 @@ def neutral(**kw: int | bool) -> Outputs:
         "pan": dp.SERVOS["pan"].default,
         "tilt": dp.SERVOS["tilt"].default,
         "laser": False,
-        "armed": True,
+        "armed": True,  # the firmware's flag: the model does not read it
     }
     base.update(kw)
     return Outputs(**base)  # type: ignore[arg-type]
@@ -192,6 +192,7 @@ def neutral(**kw: int | bool) -> Outputs:
 def airborne_model(heading: float = 0.0) -> DroneModel:
     m = DroneModel(Room(), (5.0, 4.0, heading), StickCentres.from_protocol())
     m.state.z = 1.0
+    m.state.armed = True
     return m
 
 
@@ -228,11 +229,32 @@ def test_model_walls_failsafe_and_disarm() -> None:
     run_model(m, neutral(throttle=dp.FAILSAFE_THROTTLE_US), 3.0)
     assert m.state.z == 0.0 and m.state.crashes == 0  # the failsafe lands it
     m = airborne_model()
-    run_model(m, neutral(armed=False), 2.0)
-    assert m.state.z == 0.0 and m.state.crashes == 1  # motors off in the air
+    m.state.armed = False  # forced: motors off in the air
+    run_model(m, neutral(), 2.0)
+    assert m.state.z == 0.0 and m.state.crashes == 1
+
+
+def test_model_arms_and_disarms_from_the_sticks_on_the_ground_only() -> None:
+    ch = dp.CHANNELS
+    arm = neutral(throttle=ch["throttle"].minimum, yaw=ch["yaw"].maximum)
+    disarm = neutral(throttle=ch["throttle"].minimum, yaw=ch["yaw"].minimum)
     m = DroneModel(Room(), (5.0, 4.0, 0.0), StickCentres.from_protocol())
+    run_model(m, neutral(throttle=ch["throttle"].high), 1.0)
+    assert not m.state.armed and m.state.z == 0.0  # disarmed: throttle does nothing
+    run_model(m, arm, m.p.arm_hold_s / 2)
+    run_model(m, neutral(), 0.1)  # released too early: starts again
+    run_model(m, arm, m.p.arm_hold_s / 2)
+    assert not m.state.armed
+    run_model(m, arm, m.p.arm_hold_s)
+    assert m.state.armed
     run_model(m, neutral(pitch=ch["pitch"].high, yaw=ch["yaw"].high), 1.0)  # on the ground: no sliding
     assert (m.state.x, m.state.y, m.state.z) == (5.0, 4.0, 0.0)
+    run_model(m, neutral(throttle=ch["throttle"].high), 1.0)
+    assert m.state.z > 0.2
+    run_model(m, disarm, 0.3)  # throttle minimum descends at most max_climb: not a crash, still armed
+    assert m.state.armed
+    run_model(m, disarm, 3.0)  # landed, then disarmed by the held sticks
+    assert m.state.z == 0.0 and not m.state.armed and m.state.crashes == 0
 
 
 # -- the renderer -----------------------------------------------------------------------------------------

@@ -18,6 +18,7 @@ import cv2
 import drone_protocol as dp
 import numpy as np
 import pytest
+import serial
 import yaml
 
 from pilot.config import PilotConfig
@@ -27,7 +28,7 @@ from pilot.link import Link, keepalive_ms
 from pilot.runner import RunResult, Tick, run
 from pilot.sim.room import make_scenario
 from pilot.sim.virtual import VirtualDrone
-from pilot.sim.world import SimWorld
+from pilot.sim.world import BOOT_MS, SimWorld
 from pilot.sources import Frame
 
 REPO = Path(__file__).resolve().parents[2]
@@ -54,7 +55,13 @@ def fly_and_fault(stage: str, exe: Path) -> Flight:
     scenario = make_scenario("ahead", 1)
     vd = VirtualDrone(exe)
     world = SimWorld(scenario, vd)
-    link = Link(vd.pty, clock=world.now, ready_clock=time.monotonic, ready_sleep=time.sleep).open()
+    link = Link(
+        vd.pty,
+        clock=world.now,
+        ready_clock=time.monotonic,
+        ready_sleep=time.sleep,
+        on_open=lambda: world.advance(BOOT_MS),
+    ).open()
     controller = Controller(cfg.controller, clock=world.now)
     detector = HsvBlobDetector(cfg.hsv)
     camera = world.camera()
@@ -146,6 +153,15 @@ def names(frames: list[bytes]) -> list[str]:
     return [dp.decode(f).name for f in frames]
 
 
+def assert_safe_tail(tail: list[str]) -> None:
+    """Laser off, sticks neutral, servos home, down until landed, disarm, then only keep-alives."""
+    assert tail[:3] == ["laser_toggle", "hold_altitude", "servo_reset"], tail[:6]
+    disarm = tail.index("disarm")
+    downs = tail[3:disarm]
+    assert downs and set(downs) == {"move_down"}
+    assert set(tail[disarm + 1 :]) <= {"hold_altitude"}  # keep-alives while the firmware disarms
+
+
 @pytest.mark.parametrize("stage", STAGES)
 def test_fault_in_any_stage_ends_laser_off_neutral_disarmed(stage: str, virtual_drone: Path) -> None:
     f = fly_and_fault(stage, virtual_drone)
@@ -159,8 +175,7 @@ def test_fault_in_any_stage_ends_laser_off_neutral_disarmed(stage: str, virtual_
     last_on = max(i for i, n in enumerate(sent) if n == "laser_toggle")
     assert sent.count("laser_toggle") % 2 == 0, "the laser toggles must leave it off"
     tail = sent[last_on:]
-    assert tail[:5] == ["laser_toggle", "hold_altitude", "servo_reset", "move_down", "disarm"]
-    assert set(tail[5:]) <= {"hold_altitude"}  # only keep-alives while the firmware disarms
+    assert_safe_tail(tail)
     assert not f.result.shutdown_errors
     # and what the firmware actually did about it
     out = f.world.outputs
@@ -172,6 +187,7 @@ def test_fault_in_any_stage_ends_laser_off_neutral_disarmed(stage: str, virtual_
         dp.CHANNELS["yaw"].median,
     )
     assert f.world.model.state.z == 0.0 and f.world.model.state.crashes == 0
+    assert not f.world.model.state.armed  # the flight controller saw the disarm sticks
     assert f.world.model.state.wall_hits == 0
 
 
@@ -181,7 +197,7 @@ def test_lost_camera_lands_and_disarms(virtual_drone: Path) -> None:
     r = fly("behind", 2, lose_camera_at_s=9.0, executable=virtual_drone)
     assert r.reason.startswith("camera lost: simulated camera lost at t=9.0")
     assert r.final_state == "done"
-    assert not r.final_laser and not r.final_armed and r.final_altitude == 0.0
+    assert not r.final_laser and not r.final_armed and not r.final_fc_armed and r.final_altitude == 0.0
     assert r.crashes == 0 and r.wall_hits == 0
 
 
@@ -255,7 +271,54 @@ def test_cli_signal_with_laser_on(sig: signal.Signals, tmp_path: Path) -> None:
     assert sent[0] == "arm"
     assert sent.count("laser_toggle") == 2  # on, then off after the signal
     after = sent[sent.index("laser_toggle") + 1 :]
-    off = after.index("laser_toggle")
-    assert after[off : off + 5] == ["laser_toggle", "hold_altitude", "servo_reset", "move_down", "disarm"]
-    assert set(after[off + 5 :]) <= {"hold_altitude"}
+    assert_safe_tail(after[after.index("laser_toggle") :])
     assert b"interrupted" in out
+
+
+class _Unplugged:
+    """A serial port whose cable was pulled: every read and write fails, close still works."""
+
+    def __init__(self, real: object) -> None:
+        self.real = real
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(self.real, name)
+
+    @property
+    def in_waiting(self) -> int:
+        raise serial.SerialException("device reports readiness to read but returned no data (device disconnected?)")
+
+    def write(self, data: bytes) -> int:
+        raise serial.SerialException("write failed: [Errno 5] Input/output error")
+
+    def close(self) -> None:
+        self.real.close()  # type: ignore[attr-defined]
+
+
+def test_pulled_cable_mid_flight_reconnects_and_lands(virtual_drone: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The link reopens the pty; opening it reboots the virtual board (as DTR resets an Uno), which
+    now refuses movements as not armed: the pilot lands and disarms, nothing hits anything."""
+    from pilot.sim import flight
+
+    links: list[Link] = []
+
+    class RecordingLink(Link):
+        def __init__(self, *args: object, **kwargs: object) -> None:
+            super().__init__(*args, **kwargs)  # type: ignore[arg-type]
+            links.append(self)
+
+    class Puller:
+        done = False
+
+        def on_tick(self, tick: Tick) -> None:
+            if not self.done and tick.state is State.TRACK and tick.t > 7.0:
+                self.done = True
+                links[-1]._port = _Unplugged(links[-1]._port)
+
+    monkeypatch.setattr(flight, "Link", RecordingLink)
+    r = flight.fly("ahead", 1, observers=[Puller()], executable=virtual_drone)
+    assert r.reconnects == 1 and r.error is None
+    assert r.reason == "landed" and r.final_state == "done"
+    assert not r.final_laser and not r.final_armed and not r.final_fc_armed and r.final_altitude == 0.0
+    assert r.crashes == 0 and r.wall_hits == 0
+    assert not r.fired  # it did not go on to fire at the target with a rebooted board
