@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from types import TracebackType
@@ -77,6 +78,7 @@ class Link:
         ready_clock: Callable[[], float] | None = None,
         ready_sleep: Callable[[float], None] | None = None,
         on_open: Callable[[], None] | None = None,
+        history: int = 100_000,
     ) -> None:
         self._url = port if isinstance(port, str) else None
         self._port: Any = None if isinstance(port, str) else port
@@ -84,8 +86,7 @@ class Link:
         self.ready_timeout_s = ready_timeout_s
         self.reconnect_s = reconnect_s
         self.wait_ready = wait_ready
-        self._clock = clock
-        self._sleep = sleep
+        self._clock = clock  # time stamps of the log
         # waiting for the ready line and reopening a lost port may use their own clock: the simulator
         # waits for the kernel there, not for simulated time
         self._ready_clock = ready_clock or clock
@@ -97,8 +98,8 @@ class Link:
         self._buffer = bytearray()
         self._closed = False
         self._opened = False
-        self.sent: list[bytes] = []  # every frame written, in order
-        self.replies: list[dp.Reply] = []
+        self.sent: deque[bytes] = deque(maxlen=history)  # the latest frames written, in order
+        self.replies: deque[dp.Reply] = deque(maxlen=history)
         self.ready: dp.Reply | None = None
         self.reconnects = 0
         self.last_send_t: float | None = None

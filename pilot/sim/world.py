@@ -17,7 +17,7 @@ from pilot.errors import FrameSourceError, SimulatorError
 from pilot.sim.camera import CameraModel, CameraPose, Image, Renderer
 from pilot.sim.model import DroneModel, ModelParams, Outputs, StickCentres
 from pilot.sim.room import Scenario
-from pilot.sim.virtual import Change, VirtualDrone
+from pilot.sim.virtual import VirtualDrone
 from pilot.sources import Frame
 
 BOOT_MS = 20  # the firmware boots and sends its ready line (39 bytes at 115200 baud: under 4 ms)
@@ -63,7 +63,7 @@ class SimWorld:
             raise SimulatorError("virtual drone reported no outputs at boot")
         self.outputs: Outputs = vd.outputs
         self.fw_state = vd.state
-        self.changes: list[Change] = list(changes)
+        self.changes_seen = len(changes)
         self._record_path()
 
     # -- the pacer ------------------------------------------------------------------------------
@@ -76,7 +76,7 @@ class SimWorld:
     def advance(self, ms: int) -> None:
         t0 = self.vd.t_ms
         changes = self.vd.step(ms)
-        self.changes.extend(changes)
+        self.changes_seen += len(changes)
         t = t0
         outputs = self.outputs
         pending = list(changes)

@@ -64,7 +64,7 @@ def test_loop_frames_on_the_wire_are_exactly_the_encoder_output() -> None:
             assert link.send(frame)
         wire = port.read(1000)
     assert wire == b"".join(FRAMES)
-    assert link.sent == FRAMES
+    assert list(link.sent) == FRAMES
     assert [e.data for e in log if e.kind == "tx"] == [f.decode() for f in FRAMES]
     assert any(e.kind == "rx-garbage" and "noise" in e.data for e in log)
 

@@ -170,7 +170,7 @@ def test_fault_in_any_stage_ends_laser_off_neutral_disarmed(stage: str, virtual_
         assert isinstance(f.result.error, KeyboardInterrupt)
     else:
         assert isinstance(f.result.error, Boom) and stage in str(f.result.error)
-    sent = names(f.link.sent)
+    sent = names(list(f.link.sent))
     # on the wire, after the fault: laser off, sticks neutral, servos home, down, disarm
     last_on = max(i for i, n in enumerate(sent) if n == "laser_toggle")
     assert sent.count("laser_toggle") % 2 == 0, "the laser toggles must leave it off"
