@@ -57,6 +57,7 @@ test: deps check-generated lint typecheck pytest fuzz-smoke
 
 demo: deps generate
 	$(PY) -m generator.demo
+	$(MAKE) --no-print-directory demo-flight
 
 -include firmware/firmware.mk
 -include pilot/pilot.mk
