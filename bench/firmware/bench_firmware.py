@@ -39,6 +39,14 @@ class Run:
     pulses: dict[int, list[tuple[int, int]]]
     replies: list[tuple[int, str]]  # (cycle, line)
     ram: dict[str, int]
+    asleep: list[tuple[int, int]]  # (cycle, cycles asleep so far), every 10 ms
+
+    def busy(self, start_ms: float, end_ms: float) -> float:
+        """Share of the cycles the CPU was awake (not in idle sleep) between two sample points."""
+        lo, hi = start_ms * CYCLES_PER_MS, end_ms * CYCLES_PER_MS
+        inside = [(t, a) for t, a in self.asleep if lo <= t <= hi]
+        (t0, a0), (t1, a1) = inside[0], inside[-1]
+        return 1 - (a1 - a0) / (t1 - t0)
 
     def answered(self, start_ms: float, end_ms: float) -> int:
         lo, hi = start_ms * CYCLES_PER_MS, end_ms * CYCLES_PER_MS
@@ -80,7 +88,7 @@ def bss_end(elf: Path) -> int:
 def simulate(sim: Path, elf: Path, events: list[tuple[float, bytes]], until_ms: float) -> Run:
     script = "".join(f"{t:.4f} {data.hex()}\n" for t, data in events)
     out = subprocess.run(
-        [str(sim), "--elf", str(elf), "--until", str(until_ms), "--paint", str(bss_end(elf))],
+        [str(sim), "--elf", str(elf), "--until", str(until_ms), "--paint", str(bss_end(elf)), "--load-every", "10"],
         input=script,
         capture_output=True,
         text=True,
@@ -89,6 +97,7 @@ def simulate(sim: Path, elf: Path, events: list[tuple[float, bytes]], until_ms: 
     pulses: dict[int, list[tuple[int, int]]] = {}
     replies: list[tuple[int, str]] = []
     ram: dict[str, int] = {}
+    asleep: list[tuple[int, int]] = []
     for line in out.splitlines():
         if not line.startswith("{"):
             continue
@@ -99,7 +108,9 @@ def simulate(sim: Path, elf: Path, events: list[tuple[float, bytes]], until_ms: 
             replies += [(record["t"], line) for line in record["text"].splitlines()]
         elif record["ev"] == "ram":
             ram = {k: v for k, v in record.items() if k != "ev"}
-    return Run(pulses, replies, ram)
+        elif record["ev"] == "load":
+            asleep.append((record["t"], record["asleep"]))
+    return Run(pulses, replies, ram, asleep)
 
 
 def stream(count: int, spacing_ms: float) -> list[tuple[float, bytes]]:
@@ -161,6 +172,8 @@ def main() -> None:
     oursbp = simulate(sim, elf("uno_bench_parser"), burst, w1 + 5)
     baseb = simulate(sim, elf("baseline_bench"), burst, w1 + 5)
     noleadb = simulate(sim, elf("uno_bench_nolead"), burst, w1 + 5)
+    plainb = simulate(sim, elf("uno"), burst, w1 + 5)  # no markers: the CPU load as shipped
+    busy_idle, busy_b2b = plainb.busy(20, START_MS - 20), plainb.busy(w0, w1)
     window = (w1 - w0) * CYCLES_PER_MS
     rate = oursb.answered(w0, w1) * 1000 / (w1 - w0)
     share = oursb.marked_cycles(w0, w1) / window
@@ -193,6 +206,8 @@ def main() -> None:
         f"| frames answered per second, back to back | {rate:.0f} | {base_b_answered} | |",
         f"| CPU share of the parser, back to back | {100 * parser_share:.1f} % | | |",
         f"| CPU share of all handling, back to back | {100 * share:.1f} % | | |",
+        f"| CPU awake (not idle-sleeping), no traffic | {100 * busy_idle:.1f} % | 100 % (never sleeps) | |",
+        f"| CPU awake, back to back | {100 * busy_b2b:.1f} % | 100 % | |",
     ]
     jitter_rows = [
         "| pulse generator | spread idle (µs) | spread under back-to-back frames (µs) | added by parsing (µs) |",

@@ -25,8 +25,10 @@ bool transmit(const char* data, uint8_t length) {
 
 drone::Drone the_drone(transmit);
 drone::Outputs applied;  // the outputs the pins and pulse generator were last given
-bool widths_pending = false;
+uint16_t pending_widths[pulse::OUTPUTS];
+bool widths_pending = false;  // pending_widths not yet taken by the generator
 bool laser_written = false;
+uint32_t updated_ms = 0;  // when update() last ran
 
 // Degrees to microseconds by multiply-and-shift: a 32-bit division costs
 // ~600 cycles on the AVR, this ~40. Checked equal to exact rounding for every
@@ -60,21 +62,24 @@ void widths_of(const drone::Outputs& o, uint16_t w[pulse::OUTPUTS]) {
   w[pulse::TILT] = servo_us(o.tilt);
 }
 
+// Hands the latest widths to the pulse generator; it takes them at its next
+// frame boundary, so this may have to be retried (cheaply) on later passes.
+void flush_widths() {
+  if (pulse_out::update(pending_widths)) widths_pending = false;
+}
+
 void apply_outputs() {
   const drone::Outputs& o = the_drone.outputs();
-  // Most loop passes change nothing: skip the width arithmetic (a 32-bit
-  // division per servo) unless an output moved or an update is still owed.
-  if (o == applied && !widths_pending) return;
-  applied = o;
-  if (o.laser != laser_written) {
-    digitalWrite(pins::LASER, o.laser ? HIGH : LOW);
-    laser_written = o.laser;
+  if (!(o == applied)) {
+    applied = o;
+    if (o.laser != laser_written) {
+      digitalWrite(pins::LASER, o.laser ? HIGH : LOW);
+      laser_written = o.laser;
+    }
+    widths_of(o, pending_widths);  // the newest widths always win
+    widths_pending = true;
   }
-  uint16_t w[pulse::OUTPUTS];
-  widths_of(o, w);
-  // If the generator has not latched the previous update yet, keep trying on
-  // the next passes; the newest widths always win.
-  widths_pending = !pulse_out::update(w);
+  if (widths_pending) flush_widths();
 }
 
 // Sleep until the next interrupt when no byte waits: a received byte, the
@@ -119,6 +124,7 @@ void setup() {
   digitalWrite(pins::LASER, LOW);
   laser_written = false;
   widths_pending = false;
+  updated_ms = millis();
 #ifdef DRONE_MARK_PIN
   pinMode(DRONE_MARK_PIN, OUTPUT);
   mark_reg = portInputRegister(digitalPinToPort(DRONE_MARK_PIN));
@@ -150,11 +156,19 @@ void loop() {
   if (busy) bench_mark();
 #endif
   // Bounded so timers and outputs are served even under a byte flood.
+  bool framed = false;
   for (uint8_t n = 0; n < 64 && Serial.available() > 0; ++n) {
-    the_drone.receive(static_cast<uint8_t>(Serial.read()), now);
+    framed |= the_drone.receive(static_cast<uint8_t>(Serial.read()), now);
   }
-  the_drone.update(now);
-  apply_outputs();
+  // Timers only move when millis() does, outputs only after a frame or a
+  // timer: a byte in the middle of a frame costs little more than the parser.
+  if (framed || now != updated_ms) {
+    the_drone.update(now);
+    updated_ms = now;
+    apply_outputs();
+  } else if (widths_pending) {
+    flush_widths();
+  }
 #ifdef DRONE_BENCH_PIN
   if (busy) bench_mark();
 #endif

@@ -113,7 +113,7 @@ void Drone::reply(const char* line, uint8_t length) {
   if (!tx_(line, length)) ++replies_dropped_;
 }
 
-void Drone::receive(uint8_t byte, uint32_t now_ms) {
+bool Drone::receive(uint8_t byte, uint32_t now_ms) {
   now_ms_ = now_ms;
   char line[dp::REPLY_MAX_LENGTH];
   DRONE_PARSER_MARK();
@@ -130,6 +130,7 @@ void Drone::receive(uint8_t byte, uint32_t now_ms) {
     reply(line, dp::write_rejected(e, line));
     last_parser_error_ = e;
   }
+  return complete;
 }
 
 void Drone::execute(const dp::Command& c, uint32_t now_ms) {

@@ -43,7 +43,9 @@ class Drone {
   explicit Drone(Transmit tx);
 
   void begin(uint32_t now_ms);                 // boot: safe outputs, ready line
-  void receive(uint8_t byte, uint32_t now_ms);  // one serial byte
+  // One serial byte; returns true when it completed a frame (which may have
+  // changed the outputs).
+  bool receive(uint8_t byte, uint32_t now_ms);
   void update(uint32_t now_ms);                // timers and sequences
 
   const Outputs& outputs() const { return out_; }

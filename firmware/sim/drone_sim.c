@@ -13,7 +13,11 @@
  *   {"ev":"pulse","pin":P,"rise":C,"width":C}   a high pulse on Arduino pin P
  *   {"ev":"level","pin":P,"t":C,"v":0|1}         every level change (laser pin only)
  *   {"ev":"tx","t":C,"text":"..."}                a line the firmware sent
- *   {"ev":"end","t":C,"unsent":N}                 N = script bytes never taken
+ *   {"ev":"end","t":C,"unsent":N,"asleep":S}      N = script bytes never taken, S = cycles the
+ *                                                 CPU spent asleep (idle) in all
+ *   {"ev":"load","t":C,"asleep":S}                with --load-every MS: the same count so far
+ *
+ * --profile FILE writes the cycles spent at each program address (awake).
  *
  * --paint ADDR fills the RAM from ADDR (the end of .bss, __heap_start) to
  * RAMEND with a pattern before the run, and reports at the end how far the
@@ -191,6 +195,8 @@ static void read_script(FILE *f) {
 int main(int argc, char **argv) {
   const char *elf = NULL, *mcu = "atmega328p", *script = NULL;
   long paint = -1;
+  double load_every_ms = 0;
+  const char *profile = NULL;
   double until_ms = -1;
   for (int i = 1; i < argc; ++i) {
     if (!strcmp(argv[i], "--elf") && i + 1 < argc) elf = argv[++i];
@@ -198,6 +204,8 @@ int main(int argc, char **argv) {
     else if (!strcmp(argv[i], "--until") && i + 1 < argc) until_ms = atof(argv[++i]);
     else if (!strcmp(argv[i], "--script") && i + 1 < argc) script = argv[++i];
     else if (!strcmp(argv[i], "--paint") && i + 1 < argc) paint = strtol(argv[++i], NULL, 0);
+    else if (!strcmp(argv[i], "--load-every") && i + 1 < argc) load_every_ms = atof(argv[++i]);
+    else if (!strcmp(argv[i], "--profile") && i + 1 < argc) profile = argv[++i];
     else {
       fprintf(stderr, "usage: drone_sim --elf FILE [--mcu atmega328p|atmega2560] --until MS [--script FILE]\n");
       return 2;
@@ -255,7 +263,25 @@ int main(int argc, char **argv) {
 
   const avr_cycle_count_t end = (avr_cycle_count_t)(until_ms * 16000.0);
   int state = cpu_Running;
-  while (avr->cycle < end && state != cpu_Done && state != cpu_Crashed) state = avr_run(avr);
+  avr_cycle_count_t asleep = 0;
+  const avr_cycle_count_t load_step = (avr_cycle_count_t)(load_every_ms * 16000.0);
+  avr_cycle_count_t next_load = load_step;
+  /* --profile FILE: cycles spent at each program address while awake, written
+   * as "address cycles" lines (byte addresses, for avr-addr2line / avr-nm). */
+  uint64_t *pc_cycles = profile ? calloc(avr->flashend + 1, sizeof *pc_cycles) : NULL;
+  while (avr->cycle < end && state != cpu_Done && state != cpu_Crashed) {
+    const avr_cycle_count_t before = avr->cycle;
+    const int was = avr->state;
+    const avr_flashaddr_t pc = avr->pc;
+    state = avr_run(avr);
+    if (was == cpu_Sleeping) asleep += avr->cycle - before;
+    else if (pc_cycles && pc <= avr->flashend) pc_cycles[pc] += avr->cycle - before;
+    if (load_step && avr->cycle >= next_load) {
+      printf("{\"ev\":\"load\",\"t\":%llu,\"asleep\":%llu}\n", (unsigned long long)avr->cycle,
+             (unsigned long long)asleep);
+      next_load += load_step;
+    }
+  }
   if (paint >= 0) {
     long heap_top = paint, stack_low = avr->ramend;
     while (heap_top <= avr->ramend && avr->data[heap_top] != PAINT) ++heap_top;
@@ -267,10 +293,21 @@ int main(int argc, char **argv) {
     printf("{\"ev\":\"ram\",\"heap_start\":%ld,\"heap_top\":%ld,\"stack_low\":%ld,\"ramend\":%d}\n", paint, heap_top,
            stack_low, avr->ramend);
   }
+  if (pc_cycles) {
+    FILE *pf = fopen(profile, "w");
+    if (!pf) {
+      perror(profile);
+      return 2;
+    }
+    for (uint32_t a = 0; a <= avr->flashend; ++a)
+      if (pc_cycles[a]) fprintf(pf, "%u %llu\n", a, (unsigned long long)pc_cycles[a]);
+    fclose(pf);
+    free(pc_cycles);
+  }
   size_t unsent = pending_tail - pending_head;
   for (size_t i = event_next; i < event_count; ++i) unsent += events[i].length;
-  printf("{\"ev\":\"end\",\"t\":%llu,\"unsent\":%zu,\"state\":%d}\n", (unsigned long long)avr->cycle, unsent,
-         state);
+  printf("{\"ev\":\"end\",\"t\":%llu,\"unsent\":%zu,\"state\":%d,\"asleep\":%llu}\n",
+         (unsigned long long)avr->cycle, unsent, state, (unsigned long long)asleep);
   fflush(stdout);
   return state == cpu_Crashed ? 1 : 0;
 }
