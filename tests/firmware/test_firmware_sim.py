@@ -267,6 +267,7 @@ def test_garbage_between_frames_never_changes_an_output_to_an_uncommanded_value(
         widths = result.widths_us(fw.PINS[name], start, plan.t + 50)
         stray = [w for w in widths if min(abs(w - c) for c in commanded[name]) > TOLERANCE_US]
         assert not stray, f"{name}: uncommanded widths {sorted(set(stray))[:5]}"
+    assert result.laser_at(plan.t + 50) == 0 and not result.levels, "the laser was never commanded"
     accepted = [r for r in result.replies() if r.startswith("A")]
     expected = [reply(dp.accepted_line(dp.decode(f))) for f in frames_sent]
     assert accepted[-len(expected) :] == expected  # every frame found, nothing else accepted
