@@ -98,7 +98,8 @@ FW_ELVES := $(FW_BUILD)/uno/uno.elf $(FW_BUILD)/mega/mega.elf $(FW_BUILD)/uno_pp
 FW_HEXES := $(FW_ELVES:.elf=.hex)
 
 .PHONY: firmware firmware-uno firmware-host firmware-sim firmware-clean bench-firmware
-firmware: $(FW_HEXES) firmware-host firmware-sim
+# $(APT_STAMP) (top-level Makefile) installs the toolchain on a fresh machine.
+firmware: $(APT_STAMP) $(FW_HEXES) firmware-host firmware-sim
 	@$(AVR_SIZE) -C --mcu=atmega328p $(FW_BUILD)/uno/uno.elf | grep -E 'Program|Data' | sed 's/^/uno:      /'
 	@$(AVR_SIZE) -C --mcu=atmega328p $(FW_BUILD)/uno_ppm/uno_ppm.elf | grep -E 'Program|Data' | sed 's/^/uno ppm:  /'
 	@$(AVR_SIZE) -C --mcu=atmega2560 $(FW_BUILD)/mega/mega.elf | grep -E 'Program|Data' | sed 's/^/mega:     /'

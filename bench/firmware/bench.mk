@@ -18,5 +18,5 @@ $(eval $(call fw_board,baseline_bench_parser,uno,-DDRONE_BENCH_PARSER_PIN=7,$(FW
 FW_BENCH_BOARDS := uno uno_bench uno_bench_nolead uno_bench_parser baseline baseline_bench baseline_bench_parser
 FW_BENCH_ELVES := $(foreach b,$(FW_BENCH_BOARDS),$(FW_BUILD)/$(b)/$(b).elf)
 
-bench-firmware: $(FW_BENCH_ELVES) $(FW_BUILD)/sim/drone_sim
+bench-firmware: $(VENV_STAMP) $(FW_BENCH_ELVES) $(FW_BUILD)/sim/drone_sim
 	$(PY) bench/firmware/bench_firmware.py --build $(FW_BUILD)
