@@ -131,6 +131,18 @@ def test_a_new_movement_restarts_the_command_timeout() -> None:
     assert back["t_ms"] == turn["t_ms"] + dp.COMMAND_TIMEOUT_MS
 
 
+def test_servo_and_laser_frames_do_not_end_a_movement() -> None:
+    script = fw.Script().arm()
+    t0 = script.t_ms
+    script.send(dp.move_forward(1700)).step(100).send(dp.servo_left(20) + dp.laser_toggle()).step(100)
+    trace = script.step(dp.COMMAND_TIMEOUT_MS).run()
+    during = trace.state_at(t0 + 150)
+    assert during["state"] == "moving" and during["pitch"] == 1700
+    assert during["pan"] == dp.SERVOS["pan"].default - 20 and during["laser"] is True
+    back = trace.first_change(since_ms=t0 + 2, state="hold_altitude")
+    assert back["t_ms"] == t0 + 1 + dp.COMMAND_TIMEOUT_MS  # timed from the movement, not the servo frame
+
+
 def test_hold_altitude_sets_alt_hold_mode_and_neutral_sticks_and_needs_arming() -> None:
     disarmed = fw.Script().step(5).send(dp.hold_altitude()).step(10).run()
     assert disarmed.replies(since_ms=5) == [rejected(dp.ErrorKind.NOT_ARMED)]
