@@ -173,6 +173,19 @@ void read_master() {
   }
 }
 
+// Before a step: bytes a client wrote just before its "step" line may still
+// be on their way through the kernel's pty buffer (pushed by a work queue).
+// Give them a moment, so a frame written before a step lands in that step.
+void settle_master() {
+  if (g_master < 0 || (g_inotify >= 0 && g_clients == 0)) return;
+  pollfd p;
+  p.fd = g_master;
+  p.events = POLLIN;
+  if (poll(&p, 1, 0) > 0) return;
+  const timespec pause = {0, 200 * 1000};  // 0.2 ms of wall time per quiet step
+  nanosleep(&pause, nullptr);
+}
+
 int open_pty() {
   const int m = posix_openpt(O_RDWR | O_NOCTTY);
   if (m < 0 || grantpt(m) != 0 || unlockpt(m) != 0) {
@@ -241,6 +254,8 @@ int run_stepped() {
   while (fgets(line, sizeof line, stdin)) {
     if (strncmp(line, "step", 4) == 0) {
       const long ms = strtol(line + 4, nullptr, 10);
+      reset_if_opened();
+      settle_master();
       read_master();
       for (long i = 0; i < ms; ++i) run_one_ms();
       printf("{\"tick\":%u}\n", g_t);
