@@ -20,7 +20,8 @@ States (``State``)::
 * AIM holds position and centres the target with the pan/tilt servos; after ``aim_frames`` centred
   frames FIRE switches the laser on. The laser stays on only while the target is found and centred;
   after ``fire_ms`` lit it is switched off and the drone lands (LAND: ``move_down`` for ``land_ms``,
-  then ``disarm()``).
+  then ``disarm()``). While firing, small errors (within twice the aim tolerance) are still corrected
+  with the servos; larger ones switch the laser off and go back to AIM.
 * Losing the target (``lost_frames`` misses in a row) in ACQUIRE/TRACK/AIM/FIRE: laser off, sticks
   neutral (``hold_altitude()``), servos reset, and SEARCH again.
 """
@@ -359,7 +360,9 @@ class Controller:
         on = self._laser(True)
         if on is not None:
             return on
-        return self._emit(dp.hold_altitude())
+        # still within the loose tolerance: keep centring it (a drifting drone), the laser stays on
+        correction = self._servo_correction(det)
+        return correction if correction is not None else self._emit(dp.hold_altitude())
 
     def _on_land(self, det: Detection | None) -> bytes | None:
         off = self._laser(False)

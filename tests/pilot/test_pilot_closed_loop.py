@@ -20,6 +20,9 @@ SEEDS = range(20)
 # costs ~2.7 ms a frame: a smaller set of seeds checks that it flies, the HSV sets carry the statistics.
 ARUCO_SCENARIOS = ("ahead", "side")
 ARUCO_SEEDS = range(5)
+# A steady wind (up to 0.1 m/s, seeded direction) that the pilot must keep correcting: a few seeds of each scenario.
+WIND = 0.1
+WIND_SEEDS = range(100, 104)
 REQUIRED = 0.95
 
 
@@ -31,15 +34,26 @@ def flights(virtual_drone: Path) -> dict[tuple[str, str], list[FlightResult]]:
         for name in ARUCO_SCENARIOS
         for seed in ARUCO_SEEDS
     ]
+    jobs += [
+        FlightJob(name, seed, "hsv", max_wind=WIND, executable=str(virtual_drone))
+        for name in SCENARIOS
+        for seed in WIND_SEEDS
+    ]
     results = fly_many(jobs, processes=2)
     by: dict[tuple[str, str], list[FlightResult]] = defaultdict(list)
     for job, result in zip(jobs, results, strict=True):
         assert (result.scenario, result.seed, result.detector) == (job.scenario, job.seed, job.detector)
-        by[(job.detector, job.scenario)].append(result)
+        detector = job.detector + ("+wind" if job.max_wind else "")
+        by[(detector, job.scenario)].append(result)
     return dict(by)
 
 
-CASES = [("hsv", name) for name in SCENARIOS] + [("aruco", name) for name in ARUCO_SCENARIOS]
+CASES = (
+    [("hsv", name) for name in SCENARIOS]
+    + [("aruco", name) for name in ARUCO_SCENARIOS]
+    + [("hsv+wind", name) for name in SCENARIOS]
+)
+SEEDS_OF = {"hsv": SEEDS, "aruco": ARUCO_SEEDS, "hsv+wind": WIND_SEEDS}
 
 
 @pytest.mark.parametrize("detector,scenario", CASES)
@@ -47,7 +61,7 @@ def test_scenario_reaches_and_lights_the_target(
     detector: str, scenario: str, flights: dict[tuple[str, str], list[FlightResult]]
 ) -> None:
     results = flights[(detector, scenario)]
-    assert len(results) == len(SEEDS if detector == "hsv" else ARUCO_SEEDS)
+    assert len(results) == len(SEEDS_OF[detector])
     ok = [r for r in results if r.success]
     failures = "\n".join(r.summary() for r in results if not r.success)
     assert len(ok) >= math.ceil(REQUIRED * len(results)), f"{len(ok)}/{len(results)} succeeded:\n{failures}"
@@ -70,7 +84,7 @@ def test_scenario_never_hits_a_wall_or_crashes(
 
 def test_every_flight_ends_landed_and_disarmed(flights: dict[tuple[str, str], list[FlightResult]]) -> None:
     everything = [r for rs in flights.values() for r in rs]
-    assert len(everything) == len(SCENARIOS) * len(SEEDS) + len(ARUCO_SCENARIOS) * len(ARUCO_SEEDS)
+    assert len(everything) == sum(len(SEEDS_OF[detector]) for detector, _ in CASES)
     assert all(r.final_state == "done" for r in everything)
 
 
@@ -85,6 +99,10 @@ def test_scenarios_really_differ(flights: dict[tuple[str, str], list[FlightResul
         bearing = math.degrees(math.atan2(ty - y, tx - x) - heading)
         bearing = (bearing + 180) % 360 - 180
         assert abs(bearing) > 60, (name, bearing)  # outside the 60-degree field of view at the start
+    for seed in WIND_SEEDS:
+        windy = make_scenario("ahead", seed, max_wind=WIND)
+        assert 0.0 < math.hypot(*windy.wind) <= WIND
+        assert make_scenario("ahead", seed).wind == (0.0, 0.0)
     slow = sum(r.sim_seconds for r in flights[("hsv", "behind")]) / len(SEEDS)
     fast = sum(r.sim_seconds for r in flights[("hsv", "ahead")]) / len(SEEDS)
     assert slow > fast + 1.0  # the search turn costs time

@@ -216,6 +216,15 @@ def test_laser_only_while_locked_and_centred() -> None:
     assert name(out) == "laser_toggle" and not c.laser_on and st(c) is State.AIM
 
 
+def test_small_drift_while_firing_is_corrected_with_the_laser_on() -> None:
+    c, clock = to_state(State.FIRE)
+    drift = 1.5 * CFG.aim_tolerance  # beyond the aim tolerance, within the loose firing one
+    out = tick(c, clock, seen(drift, size=0.25))
+    assert name(out) == "servo_right" and c.laser_on and st(c) is State.FIRE
+    out = tick(c, clock, seen(0.0, -drift, size=0.25))
+    assert name(out) == "servo_up" and c.laser_on and st(c) is State.FIRE
+
+
 @pytest.mark.parametrize("state", [State.TRACK, State.AIM, State.FIRE])
 def test_target_lost_means_laser_off_neutral_and_search(state: State) -> None:
     c, clock = to_state(state)
