@@ -16,6 +16,19 @@ namespace drone_app {
 
 namespace {
 
+// The longest pulses the protocol allows must fit one output frame with a
+// gap to spare, or the generator would stretch the frame (pulse_schedule.cpp).
+constexpr uint32_t MODE_MAX_US =
+    drone::dp::MODE_ALT_HOLD_US > drone::dp::MODE_STABILIZE_US ? drone::dp::MODE_ALT_HOLD_US
+                                                               : drone::dp::MODE_STABILIZE_US;
+constexpr uint32_t RC_MAX_SUM_US = static_cast<uint32_t>(drone::dp::ROLL_MAX) + drone::dp::PITCH_MAX +
+                                   drone::dp::THROTTLE_MAX + drone::dp::YAW_MAX + MODE_MAX_US;
+static_assert(RC_MAX_SUM_US + 2u * pulse_timing::SERVO_MAX_US + 2000u <= pulse_timing::PWM_FRAME_US,
+              "the widest parallel-PWM pulses no longer fit a 50 Hz frame");
+static_assert(RC_MAX_SUM_US + pulse_timing::PPM_SEPARATOR_US + 2u * pulse_timing::SERVO_MAX_US + 3000u <=
+                  pulse_timing::PPM_FRAME_US,
+              "the widest PPM channels no longer leave a sync gap");
+
 bool transmit(const char* data, uint8_t length) {
   // Never block the loop on a slow or absent reader: drop the reply instead.
   if (Serial.availableForWrite() < static_cast<int>(length)) return false;

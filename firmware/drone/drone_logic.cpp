@@ -54,6 +54,10 @@ uint16_t clamp16(int32_t v, uint16_t lo, uint16_t hi) {
 
 dp::ChannelLimits limits(dp::Target t) { return dp::channel_limits(t); }
 
+// The failsafe throttle is the one output allowed outside Table 4: it must lie
+// below the recorded minimum for the flight controller to see a radio failsafe.
+static_assert(dp::FAILSAFE_THROTTLE_US < dp::THROTTLE_MIN, "failsafe throttle must be below the throttle range");
+
 uint8_t servo_default(dp::Target t) { return t == dp::Target::Pan ? dp::SERVO_PAN_DEFAULT : dp::SERVO_TILT_DEFAULT; }
 uint8_t servo_min(dp::Target t) { return t == dp::Target::Pan ? dp::SERVO_PAN_MIN : dp::SERVO_TILT_MIN; }
 uint8_t servo_max(dp::Target t) { return t == dp::Target::Pan ? dp::SERVO_PAN_MAX : dp::SERVO_TILT_MAX; }
