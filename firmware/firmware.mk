@@ -123,7 +123,14 @@ $(FW_HOST_DIR)/pulse_schedule_test: $(FW_DIR)/host/pulse_schedule_test.cpp $(FW_
 	@echo "  CXX   $@"
 	@$(HOST_CXX) $(FW_HOST_FLAGS) $(filter %.cpp,$^) -o $@
 
-firmware-host: $(FW_HOST_DIR)/virtual_drone $(FW_HOST_DIR)/pulse_schedule_test
+# libFuzzer target over the whole logic (clang, from the toolchain stamp).
+$(FW_HOST_DIR)/fuzz_drone: $(FW_DIR)/host/fuzz_drone.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_HEADERS) $(FW_PROTO_HDR)
+	@mkdir -p $(@D)
+	@echo "  CXX   $@"
+	@clang++ -std=c++11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all $(FW_WARN) \
+	  -I$(FW_DIR)/drone -I$(DRONE_PROTOCOL_DIR)/src $(filter %.cpp,$^) -o $@
+
+firmware-host: $(FW_HOST_DIR)/virtual_drone $(FW_HOST_DIR)/pulse_schedule_test $(FW_HOST_DIR)/fuzz_drone
 
 # --- simavr harness -----------------------------------------------------------
 $(FW_BUILD)/sim/drone_sim: $(FW_DIR)/sim/drone_sim.c
