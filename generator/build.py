@@ -18,7 +18,10 @@ from generator.source import INVALID, Node, load
 T = TypeVar("T")
 
 # Parser errors the generated code raises itself; the spec gives their codes and descriptions.
-PARSER_ERRORS = ("bad_category", "bad_direction", "bad_digit", "out_of_range", "too_short", "too_long", "timeout")
+# The stream parser's own kinds come first (it counts those in one small array); too_short and too_long are
+# whole-frame decode()'s only.
+PARSER_ERRORS = ("bad_category", "bad_direction", "bad_digit", "out_of_range", "timeout", "too_short", "too_long")
+STREAM_ERRORS = PARSER_ERRORS[:5]
 # The ones decode() and encode() raise (timeout is the stream's alone).
 FRAME_ERRORS = tuple(e for e in PARSER_ERRORS if e != "timeout")
 REPLIES = ("ready", "accepted", "rejected", "failsafe")

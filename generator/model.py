@@ -74,6 +74,17 @@ class Category:
 
 
 @dataclass(frozen=True)
+class ByteLookup:
+    """A dense table from a byte to an index + 1 (0: none), covering codes first..first + len(entries) - 1.
+
+    The C++ parser looks a byte up in constant time with it, where scanning the spec's lists cost most of
+    the parser's cycles on the Arduino."""
+
+    first: int
+    entries: tuple[int, ...]
+
+
+@dataclass(frozen=True)
 class Command:
     """A (category, direction) pair flattened for the templates."""
 
@@ -164,6 +175,19 @@ class Spec:
         return tuple(out)
 
     @property
+    def category_lookup(self) -> ByteLookup:
+        return _lookup({ord(c.code): i for i, c in enumerate(self.categories)})
+
+    @property
+    def category_ranges(self) -> tuple[tuple[int, int], ...]:
+        """(index of the first command, number of commands) of each category, in order."""
+        out, first = [], 0
+        for cat in self.categories:
+            out.append((first, len(cat.directions)))
+            first += len(cat.directions)
+        return tuple(out)
+
+    @property
     def targets(self) -> tuple[str, ...]:
         """Every output a command can drive, in a stable order (C++ Target enum after None)."""
         return tuple(c.name for c in self.channels) + tuple(s.name for s in self.servos) + ("both",)
@@ -177,3 +201,8 @@ class Spec:
     @property
     def digits_width(self) -> int:
         return self.frame_length - 2
+
+
+def _lookup(index_by_code: dict[int, int]) -> ByteLookup:
+    first, last = min(index_by_code), max(index_by_code)
+    return ByteLookup(first, tuple(index_by_code.get(code, -1) + 1 for code in range(first, last + 1)))

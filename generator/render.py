@@ -10,7 +10,7 @@ from pathlib import Path
 import jinja2
 
 from generator import filters
-from generator.build import FRAME_ERRORS, PARSER_ERRORS
+from generator.build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
 from generator.model import Spec
 from generator.names import pascal
 from generator.targets import TARGETS, Target
@@ -62,6 +62,7 @@ def render_all(spec: Spec) -> dict[str, bytes]:
         "library": pascal(spec.name),
         "frame_errors": FRAME_ERRORS,
         "parser_error_count": sum(1 for e in spec.errors if e.name in PARSER_ERRORS),
+        "stream_error_count": len(STREAM_ERRORS),
         "reply_max_length": max(len(spec.reply("ready").prefix) + len(spec.name) + 19,
                                 max(len(r.prefix) for r in spec.replies) + 3),
     }

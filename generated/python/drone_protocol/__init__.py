@@ -218,12 +218,12 @@ class ErrorKind(StrEnum):
     BAD_DIGIT = "g"
     #: The value is outside the command's allowed range
     OUT_OF_RANGE = "r"
+    #: A partial frame was dropped after an inter-byte gap
+    TIMEOUT = "t"
     #: The frame has fewer than 6 bytes
     TOO_SHORT = "s"
     #: The frame has more than 6 bytes
     TOO_LONG = "l"
-    #: A partial frame was dropped after an inter-byte gap
-    TIMEOUT = "t"
     #: A movement or turn was refused because the drone is disarmed
     NOT_ARMED = "n"
     #: Refused while an arming, disarming or self-test sequence runs

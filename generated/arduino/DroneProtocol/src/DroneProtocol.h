@@ -27,6 +27,14 @@
 #define DRONE_PROTOCOL_FLASH
 #endif
 
+#if defined(__GNUC__)
+#define DRONE_PROTOCOL_ALWAYS_INLINE inline __attribute__((always_inline))
+#define DRONE_PROTOCOL_NOINLINE __attribute__((noinline))
+#else
+#define DRONE_PROTOCOL_ALWAYS_INLINE inline
+#define DRONE_PROTOCOL_NOINLINE
+#endif
+
 namespace drone_protocol {
 
 namespace detail {
@@ -153,6 +161,7 @@ enum class CommandId : uint8_t {
   FirstTest = 17,  // it0000: Runs a series of tests
 };
 constexpr uint8_t COMMAND_COUNT = 18;
+static_assert(COMMAND_COUNT <= 127, "command indexes are int8_t");
 
 // Why a frame, a byte or a command was rejected. The parser counts its own kinds; the firmware adds refusals.
 enum class Error : uint8_t {
@@ -161,13 +170,14 @@ enum class Error : uint8_t {
   BadDirection = 2,  // 'd': The second byte is not a direction of that category
   BadDigit = 3,  // 'g': A value byte is not an ASCII digit
   OutOfRange = 4,  // 'r': The value is outside the command's allowed range
-  TooShort = 5,  // 's': The frame has fewer than 6 bytes
-  TooLong = 6,  // 'l': The frame has more than 6 bytes
-  Timeout = 7,  // 't': A partial frame was dropped after an inter-byte gap
+  Timeout = 5,  // 't': A partial frame was dropped after an inter-byte gap
+  TooShort = 6,  // 's': The frame has fewer than 6 bytes
+  TooLong = 7,  // 'l': The frame has more than 6 bytes
   NotArmed = 8,  // 'n': A movement or turn was refused because the drone is disarmed
   Busy = 9,  // 'b': Refused while an arming, disarming or self-test sequence runs
 };
 constexpr uint8_t PARSER_ERROR_COUNT = 7;  // Error values 1..this are the parser's
+constexpr uint8_t STREAM_ERROR_COUNT = 5;  // values 1..this are the ones a StreamParser meets
 
 inline const char* error_name(Error error) {
   switch (error) {
@@ -181,12 +191,12 @@ inline const char* error_name(Error error) {
       return "bad_digit";
     case Error::OutOfRange:
       return "out_of_range";
+    case Error::Timeout:
+      return "timeout";
     case Error::TooShort:
       return "too_short";
     case Error::TooLong:
       return "too_long";
-    case Error::Timeout:
-      return "timeout";
     case Error::NotArmed:
       return "not_armed";
     case Error::Busy:
@@ -197,7 +207,7 @@ inline const char* error_name(Error error) {
 
 namespace detail {
 // Reply code letters indexed by Error (a flash string: a switch here would become a table in RAM).
-DRONE_PROTOCOL_FLASH const char ERROR_CODES[] = "?cdgrsltnb";
+DRONE_PROTOCOL_FLASH const char ERROR_CODES[] = "?cdgrtslnb";
 }  // namespace detail
 
 // The code letter of the reply that reports `error`.
@@ -246,19 +256,29 @@ DRONE_PROTOCOL_FLASH const CommandInfo COMMANDS[COMMAND_COUNT] = {
     {'i', 't', 0, 0, 0, 1, Target::None, 0},  // first_test
 };
 
-struct CategoryInfo {
-  uint8_t code;
-  uint8_t first;  // index of its first command in COMMANDS
+// The category of a first byte in constant time (a dense table in flash: index + 1, 0 for none); then a
+// short scan of that category's direction bytes. Scanning every category cost most of the parser's cycles.
+constexpr uint8_t CATEGORY_COUNT = 5;
+constexpr uint8_t CATEGORY_FIRST = 105;
+constexpr uint8_t CATEGORY_SPAN = 12;
+DRONE_PROTOCOL_FLASH const uint8_t CATEGORY_LOOKUP[CATEGORY_SPAN] = {5, 0, 0, 4, 1, 0, 0, 0, 0, 0, 3, 2};
+
+struct CategoryRange {
+  uint8_t first;  // index of its first command
   uint8_t count;
 };
 
-constexpr uint8_t CATEGORY_COUNT = 5;
-DRONE_PROTOCOL_FLASH const CategoryInfo CATEGORIES[CATEGORY_COUNT] = {
-    {'m', 0, 6},  // move
-    {'t', 6, 2},  // turn
-    {'s', 8, 5},  // servo
-    {'l', 13, 1},  // laser
-    {'i', 14, 4},  // init
+DRONE_PROTOCOL_FLASH const CategoryRange CATEGORY_RANGES[CATEGORY_COUNT] = {
+    {0, 6},  // move
+    {6, 2},  // turn
+    {8, 5},  // servo
+    {13, 1},  // laser
+    {14, 4},  // init
+};
+
+// The direction byte of every command, in command order.
+DRONE_PROTOCOL_FLASH const uint8_t DIRECTION_CODES[COMMAND_COUNT] = {
+'f', 'b', 'l', 'r', 'u', 'd', 'l', 'r', 'u', 'd', 'l', 'r', 'x', '0', 'a', 'k', 's', 't'
 };
 
 constexpr uint8_t CHANNEL_COUNT = 4;
@@ -269,22 +289,20 @@ DRONE_PROTOCOL_FLASH const ChannelLimits CHANNELS[CHANNEL_COUNT] = {
     {THROTTLE_MIN, THROTTLE_MAX, THROTTLE_MEDIAN, THROTTLE_LOW, THROTTLE_HIGH},
 };
 
-// Linear scans of small flash tables: no switch, which avr-gcc would turn into lookup tables in RAM.
+// The index of the category of this first byte, or -1.
 inline int8_t find_category(uint8_t byte) {
-  for (uint8_t i = 0; i < CATEGORY_COUNT; ++i) {
-    if (read_byte(&CATEGORIES[i].code) == byte) return static_cast<int8_t>(i);
-  }
-  return -1;
+  const uint8_t i = static_cast<uint8_t>(byte - CATEGORY_FIRST);
+  return i < CATEGORY_SPAN ? static_cast<int8_t>(read_byte(&CATEGORY_LOOKUP[i]) - 1) : -1;
 }
 
 // The index of the command with these first two bytes, or -1.
 inline int8_t find_command(uint8_t category, uint8_t direction) {
   const int8_t c = find_category(category);
   if (c < 0) return -1;
-  const uint8_t first = read_byte(&CATEGORIES[c].first);
-  const uint8_t end = static_cast<uint8_t>(first + read_byte(&CATEGORIES[c].count));
+  const uint8_t first = read_byte(&CATEGORY_RANGES[c].first);
+  const uint8_t end = static_cast<uint8_t>(first + read_byte(&CATEGORY_RANGES[c].count));
   for (uint8_t i = first; i < end; ++i) {
-    if (read_byte(&COMMANDS[i].direction) == direction) return static_cast<int8_t>(i);
+    if (read_byte(&DIRECTION_CODES[i]) == direction) return static_cast<int8_t>(i);
   }
   return -1;
 }
@@ -298,9 +316,8 @@ inline Error check_byte(const uint8_t* frame, uint8_t pos) {
   return (frame[pos] >= '0' && frame[pos] <= '9') ? Error::None : Error::BadDigit;
 }
 
-// Value and range check of a frame whose first FRAME_LENGTH - 1 bytes... all bytes are valid.
-inline Error finish(const uint8_t* frame, Command& out) {
-  const int8_t index = find_command(frame[0], frame[1]);
+// Value and range check of a frame whose bytes are all valid; `index` is its command's.
+inline Error finish(const uint8_t* frame, int8_t index, Command& out) {
   uint16_t value = 0;
   for (uint8_t i = 2; i < FRAME_LENGTH; ++i) value = static_cast<uint16_t>(value * 10u + (frame[i] - '0'));
   const CommandInfo* info = &COMMANDS[index];
@@ -391,7 +408,7 @@ inline Error decode(const uint8_t* frame, size_t length, Command& out) {
     const Error error = detail::check_byte(frame, pos);
     if (error != Error::None) return error;
   }
-  return detail::finish(frame, out);
+  return detail::finish(frame, detail::find_command(frame[0], frame[1]), out);
 }
 
 inline Error decode(const uint8_t frame[FRAME_LENGTH], Command& out) { return decode(frame, FRAME_LENGTH, out); }
@@ -420,55 +437,86 @@ inline Error encode(const Command& command, uint8_t out[FRAME_LENGTH]) {
 class StreamParser {
  public:
   // constexpr: a global parser is zero-initialised in .bss, with no constructor code at start-up.
-  constexpr StreamParser() : buffer_{}, length_(0), last_error_(Error::None), last_ms_(0), command_{}, counts_{} {}
+  constexpr StreamParser()
+      : buffer_{}, length_(0), index_(0), last_error_(Error::None), last_ms_(0), command_{}, counts_{} {}
 
   // Returns true when `byte` completes a valid frame; then command() holds it until the next feed().
-  bool feed(uint8_t byte, uint32_t now_ms) {
+  // Kept small so that it inlines: a middle digit of a frame, the common case, costs a few comparisons.
+  DRONE_PROTOCOL_ALWAYS_INLINE bool feed(uint8_t byte, uint32_t now_ms) {
     last_error_ = Error::None;
-    if (length_ > 0 && static_cast<uint32_t>(now_ms - last_ms_) > INTER_BYTE_TIMEOUT_MS) {
-      count(Error::Timeout);
-      length_ = 0;
-    }
+    if (length_ > 0 && static_cast<uint32_t>(now_ms - last_ms_) > INTER_BYTE_TIMEOUT_MS) drop_stale();
     last_ms_ = now_ms;
+    // The common cases inline, each a check of the new byte alone (the buffer holds a valid prefix):
+    if (length_ >= 2) {
+      if (length_ < FRAME_LENGTH - 1 && static_cast<uint8_t>(byte - '0') <= 9u) {
+        buffer_[length_++] = byte;  // a middle digit
+        return false;
+      }
+    } else if (length_ == 1) {
+      const int8_t index = detail::find_command(buffer_[0], byte);
+      if (index >= 0) {
+        index_ = index;
+        buffer_[length_++] = byte;
+        return false;
+      }
+    } else if (detail::is_category(byte)) {
+      buffer_[length_++] = byte;
+      return false;
+    }
+    return append(byte);
+  }
+
+  const Command& command() const { return command_; }
+  // The first error of the last feed(), or Error::None.
+  Error last_error() const { return last_error_; }
+  // How many times each kind was met (saturating); the kinds of whole-frame decode() only are always 0.
+  uint16_t error_count(Error error) const {
+    const uint8_t i = static_cast<uint8_t>(error);
+    return (i >= 1 && i <= STREAM_ERROR_COUNT) ? counts_[i - 1] : 0;
+  }
+  // Bytes of a frame started but not complete.
+  uint8_t pending() const { return length_; }
+  void reset() { *this = StreamParser(); }
+
+ private:
+  void drop_stale() {
+    count(Error::Timeout);
+    length_ = 0;
+  }
+
+  // Append a byte that needs checking; on an invalid prefix, slide forward one byte at a time until the
+  // buffer holds a valid prefix again (at most FRAME_LENGTH slides of FRAME_LENGTH checks: never stalls).
+  DRONE_PROTOCOL_NOINLINE bool append(uint8_t byte) {
     buffer_[length_++] = byte;
-    // A value digit that does not end the frame needs no table walk: the prefix before it is valid.
-    if (length_ > 2 && length_ < FRAME_LENGTH && static_cast<uint8_t>(byte - '0') <= 9u) return false;
     // Only the new byte needs checking while the prefix is valid; after a slide, every byte does.
     uint8_t from = static_cast<uint8_t>(length_ - 1);
     while (length_ > 0) {
       Error error = Error::None;
-      for (uint8_t pos = from; pos < length_ && error == Error::None; ++pos) error = detail::check_byte(buffer_, pos);
-      if (error == Error::None && length_ == FRAME_LENGTH) error = detail::finish(buffer_, command_);
+      for (uint8_t pos = from; pos < length_ && error == Error::None; ++pos) error = check(pos);
+      if (error == Error::None && length_ == FRAME_LENGTH) error = detail::finish(buffer_, index_, command_);
       if (error == Error::None) {
         if (length_ < FRAME_LENGTH) return false;
         length_ = 0;
         return true;
       }
       count(error);
-      memmove(buffer_, buffer_ + 1, --length_);
+      --length_;
+      for (uint8_t i = 0; i < length_; ++i) buffer_[i] = buffer_[i + 1];
       from = 0;
     }
     return false;
   }
 
-  const Command& command() const { return command_; }
-  // The first error of the last feed(), or Error::None.
-  Error last_error() const { return last_error_; }
-  uint16_t error_count(Error error) const {
-    const uint8_t i = static_cast<uint8_t>(error);
-    return (i >= 1 && i <= PARSER_ERROR_COUNT) ? counts_[i - 1] : 0;
-  }
-  // Bytes of a frame started but not complete.
-  uint8_t pending() const { return length_; }
-  void reset() {
-    length_ = 0;
-    last_ms_ = 0;
-    last_error_ = Error::None;
-    command_ = Command();
-    for (uint8_t i = 0; i < PARSER_ERROR_COUNT; ++i) counts_[i] = 0;
+  // Byte `pos` given that the bytes before it are valid; remembers the command found at byte 1.
+  Error check(uint8_t pos) {
+    if (pos == 0) return detail::is_category(buffer_[0]) ? Error::None : Error::BadCategory;
+    if (pos == 1) {
+      index_ = detail::find_command(buffer_[0], buffer_[1]);
+      return index_ >= 0 ? Error::None : Error::BadDirection;
+    }
+    return (buffer_[pos] >= '0' && buffer_[pos] <= '9') ? Error::None : Error::BadDigit;
   }
 
- private:
   void count(Error error) {
     if (last_error_ == Error::None) last_error_ = error;
     uint16_t& n = counts_[static_cast<uint8_t>(error) - 1];
@@ -477,11 +525,13 @@ class StreamParser {
 
   uint8_t buffer_[FRAME_LENGTH];
   uint8_t length_;
+  int8_t index_;  // the command of buffer_[0..1], valid while length_ >= 2
   Error last_error_;
   uint32_t last_ms_;
   Command command_;
-  uint16_t counts_[PARSER_ERROR_COUNT];
+  uint16_t counts_[STREAM_ERROR_COUNT];
 };
+static_assert(static_cast<uint8_t>(Error::Timeout) <= STREAM_ERROR_COUNT, "the stream counts timeouts");
 
 namespace detail {
 template <class H>
