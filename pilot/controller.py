@@ -12,11 +12,14 @@ States (``State``)::
 
 * ARM sends ``arm()`` and waits the firmware's arming hold (``ARMING_HOLD_MS``) plus a margin.
 * TAKEOFF climbs (``move_up``) for ``takeoff_ms``; HOLD sends ``hold_altitude()`` for ``settle_ms``.
-* SEARCH turns (a bounded sweep: ``search_max_ms``, then LAND) towards the side the target was last seen.
-* ACQUIRE stops turning and needs ``acquire_frames`` consecutive sightings to go on to TRACK.
+* SEARCH turns (a bounded sweep: ``search_max_ms`` in all, unconfirmed sightings included, then LAND)
+  towards the side the target was last seen.
+* ACQUIRE stops turning and needs ``acquire_frames`` consecutive sightings to go on to TRACK; after
+  ``lost_frames`` misses in a row it searches again.
 * TRACK corrects one axis per frame: yaw while the horizontal error is outside its dead band, then
   height while the vertical error is, else forward until the apparent size reaches ``approach_size``.
-  AIM begins there and returns to TRACK only below ``retreat_size`` (hysteresis).
+  AIM begins there and returns to TRACK only below ``retreat_size`` (hysteresis). Up to ``coast_frames``
+  missed frames during a forward approach keep it going (a far target flickers in and out of detection).
 * AIM holds position and centres the target with the pan/tilt servos; after ``aim_frames`` centred
   frames FIRE switches the laser on. The laser stays on only while the target is found and centred;
   after ``fire_ms`` lit it is switched off and the drone lands (LAND: ``move_down`` for ``land_ms``,
@@ -100,6 +103,8 @@ class Controller:
         self._laser_since_ms = 0
         self._sent_entry = False
         self._airborne_at_abort = False
+        self._coast: bytes | None = None
+        self._search_started_ms = self._now()
         self._pan_offset = 0  # degrees the pilot has moved the pan servo from its default
         self._tilt_offset = 0
         tan_h = math.tan(math.radians(self.cfg.horizontal_fov_deg) / 2.0)
@@ -116,11 +121,14 @@ class Controller:
         if new is self.state:
             return
         self.transitions.append(Transition(self._now(), self.state, new, reason))
+        if new is State.SEARCH and self.state is not State.ACQUIRE:
+            self._search_started_ms = self._now()  # a sighting that is not confirmed does not restart the sweep
         self.state = new
         self._entered_ms = self._now()
         self._sent_entry = False
         self._hits = 0 if new is State.SEARCH else self._hits
         self._misses = 0
+        self._coast = None
         self._centred = 0
 
     def _emit(self, frame: bytes) -> bytes:
@@ -226,7 +234,7 @@ class Controller:
         if self._found(det):
             self._go(State.ACQUIRE, "target seen")
             return self._on_acquire(det)
-        if self._elapsed() >= self.cfg.search_max_ms:
+        if self._now() - self._search_started_ms >= self.cfg.search_max_ms:
             self._go(State.LAND, "search sweep exhausted")
             return self._on_land(det)
         if self._pan_offset or self._tilt_offset:
@@ -259,15 +267,20 @@ class Controller:
                 self._go(State.TRACK, f"seen in {self._hits} consecutive frames")
                 return self._on_track(det)
             return self._emit(dp.hold_altitude())
-        self._hits = 0
-        self._go(State.SEARCH, "sighting not confirmed")
+        self._hits = 0  # the sightings must be consecutive
+        self._misses += 1
+        if self._misses >= self.cfg.lost_frames:  # hovering, a flickering far target gets a few chances
+            self._go(State.SEARCH, "sighting not confirmed")
         return self._emit(dp.hold_altitude())
 
     def _on_track(self, det: Detection | None) -> bytes | None:
         if self._lost(det, self.cfg.lost_frames):
             return self._to_search("target lost while tracking")
         if det is None or not det.found:
+            if self._coast is not None and self._misses <= self.cfg.coast_frames:
+                return self._emit(self._coast)  # a missed frame or two (a far, flickering target): keep approaching
             return self._emit(dp.hold_altitude())
+        self._coast = None
         cfg = self.cfg
         if self._pan_offset or self._tilt_offset:
             self._pan_offset = self._tilt_offset = 0
@@ -288,7 +301,8 @@ class Controller:
             self._go(State.AIM, f"close enough (size {size:.3f})")
             return self._on_aim(det)
         frac = 1.8 if size < 0.45 * cfg.approach_size else (1.0 if size < 0.75 * cfg.approach_size else 0.6)
-        return self._emit(dp.move_forward(_speed("move_forward", frac)))
+        self._coast = self._emit(dp.move_forward(_speed("move_forward", frac)))
+        return self._coast
 
     def _remember_side(self, det: Detection) -> None:
         """Which way to sweep if the target is lost: its bearing from the body (camera pan included)."""

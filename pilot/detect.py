@@ -140,7 +140,9 @@ class ArucoMarkerDetector:
     def __init__(self, config: ArucoConfig | None = None) -> None:
         cfg = config or ArucoConfig()
         self.marker_id = cfg.marker_id
-        self._detector = cv2.aruco.ArucoDetector(aruco_dictionary(cfg.dictionary), cv2.aruco.DetectorParameters())
+        params = cv2.aruco.DetectorParameters()
+        params.adaptiveThreshConstant = cfg.adaptive_thresh_constant
+        self._detector = cv2.aruco.ArucoDetector(aruco_dictionary(cfg.dictionary), params)
 
     def detect(self, image: MatLike) -> Detection:
         grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image

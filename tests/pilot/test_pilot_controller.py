@@ -112,13 +112,36 @@ def test_acquire_needs_consecutive_frames() -> None:
     c, clock = to_state(State.SEARCH)
     assert name(tick(c, clock, seen(0.3))) == "hold_altitude"  # stop turning
     assert st(c) is State.ACQUIRE
-    out = tick(c, clock, MISS)
-    assert st(c) is State.SEARCH and name(out) == "hold_altitude"
-    for _ in range(CFG.acquire_frames - 1):
+    # a flickering sighting: hits and misses alternate; never N in a row, so no tracking
+    for _ in range(10):
+        assert name(tick(c, clock, MISS)) == "hold_altitude"
+        tick(c, clock, seen(0.3))
+        assert st(c) is State.ACQUIRE
+    for _ in range(CFG.acquire_frames - 2):
         tick(c, clock, seen(0.3))
         assert st(c) is State.ACQUIRE
     out = tick(c, clock, seen(0.3))
     assert st(c) is State.TRACK and name(out) == "turn_right"
+
+
+def test_acquire_gives_up_after_missing_frames() -> None:
+    c, clock = to_state(State.SEARCH)
+    tick(c, clock, seen(0.3))
+    for _ in range(CFG.lost_frames - 1):
+        tick(c, clock, MISS)
+        assert st(c) is State.ACQUIRE
+    tick(c, clock, MISS)
+    assert st(c) is State.SEARCH and c.transitions[-1].reason == "sighting not confirmed"
+
+
+def test_unconfirmed_sightings_do_not_extend_the_sweep() -> None:
+    c, clock = to_state(State.SEARCH)
+    start = clock.t
+    while st(c) is not State.LAND:
+        # one sighting every second, never confirmed
+        tick(c, clock, seen(0.3) if round((clock.t - start) * 20) % 20 == 0 else MISS)
+        assert clock.t - start < CFG.search_max_ms / 1000.0 + 1.0, "the sweep must stay bounded"
+    assert c.transitions[-1].reason == "search sweep exhausted"
 
 
 @pytest.mark.parametrize(
@@ -144,6 +167,18 @@ def test_track_dead_bands(ex: float, ey: float, expected: str) -> None:
     median = dp.CHANNELS[spec.target].median
     assert spec.minimum <= value <= spec.maximum
     assert value != median
+
+
+def test_track_coasts_through_a_few_missed_frames_only_when_approaching() -> None:
+    c, clock = to_state(State.TRACK)
+    forward = tick(c, clock, seen(size=0.05))
+    assert name(forward) == "move_forward"
+    coasted = [tick(c, clock, MISS) for _ in range(CFG.coast_frames)]
+    assert coasted == [forward] * CFG.coast_frames
+    assert name(tick(c, clock, MISS)) == "hold_altitude"  # then neutral until lost
+    c, clock = to_state(State.TRACK)
+    assert name(tick(c, clock, seen(0.4))) == "turn_right"
+    assert name(tick(c, clock, MISS)) == "hold_altitude"  # no coasting on a turn
 
 
 def test_turn_speed_grows_with_the_error() -> None:
