@@ -135,3 +135,24 @@ def test_help_lists_the_options(flag: str) -> None:
     with pytest.raises(SystemExit) as info:
         call(flag)
     assert info.value.code == 0
+
+
+def test_fingerprint_mismatch_refused_before_anything_is_sent(tmp_path: Path) -> None:
+    import select
+    import tty
+
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    cv2.imwrite(str(folder / "0.png"), synth.background(320, 240))
+    master, slave = os.openpty()
+    tty.setraw(slave)
+    try:
+        other = "0" * len(dp.SPEC_FINGERPRINT) if dp.SPEC_FINGERPRINT != "0" * 16 else "1" * 16
+        os.write(master, dp.ready_line().replace(dp.SPEC_FINGERPRINT.encode(), other.encode()))
+        code, _out, err = call("--port", os.ttyname(slave), "--arm", "--images", str(folder), "--no-status")
+        assert code == 2
+        assert "spec fingerprint mismatch" in err and other in err and "refusing to fly" in err
+        assert not select.select([master], [], [], 0.2)[0]  # not a byte went to the drone
+    finally:
+        os.close(master)
+        os.close(slave)
