@@ -156,3 +156,22 @@ def test_fingerprint_mismatch_refused_before_anything_is_sent(tmp_path: Path) ->
     finally:
         os.close(master)
         os.close(slave)
+
+
+def test_record_of_a_dry_run_on_frames(tmp_path: Path) -> None:
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    for i in range(5):
+        cv2.imwrite(str(folder / f"{i}.png"), synth.red_disc(synth.background(320, 240), 100 + 10 * i, 120, 20))
+    rec = tmp_path / "rec"
+    code, out, _err = call("--images", str(folder), "--record", str(rec), "--no-status")
+    assert code == 1 and f"recording: {rec / 'flight.avi'}" in out
+    lines = [json.loads(line) for line in (rec / "log.jsonl").read_text().splitlines()]
+    ticks = [d for d in lines if "tick" in d]
+    assert len(ticks) == 5
+    assert [round(d["detection"]["cx"]) for d in ticks] == [100, 110, 120, 130, 140]
+    assert "no path picture" in lines[-1]["result"]["note"]
+    assert not (rec / "path.png").exists()
+    cap = cv2.VideoCapture(str(rec / "flight.avi"))
+    assert int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) == 5
+    cap.release()
