@@ -229,12 +229,19 @@ def _shutdown(controller: Controller, sink: Sink, pacer: Pacer, keepalive_ms: in
     def sender(frame: bytes) -> Callable[[], object]:
         return lambda: sink.send(frame)
 
-    for frame in controller.safe_steps():
-        result.safe_frames.append(frame)
-        _guarded(result, f"send {frame!r}", sender(frame))
-        _guarded(result, "poll", sink.poll)
-        _guarded(result, "pace", pacer.wait_tick)
-    _finish_disarm(sink, pacer, keepalive_ms, result)
+    try:
+        for frame in controller.safe_steps():
+            result.safe_frames.append(frame)
+            _guarded(result, f"send {frame!r}", sender(frame))
+            _guarded(result, "poll", sink.poll)
+            _guarded(result, "pace", pacer.wait_tick)
+        _finish_disarm(sink, pacer, keepalive_ms, result)
+    except KeyboardInterrupt:
+        # a second Ctrl-C (or SIGTERM) while landing: laser and sticks are already safe; disarm now and go
+        if not result.safe_frames or result.safe_frames[-1] != dp.disarm():
+            result.safe_frames.append(dp.disarm())
+            _guarded(result, "send disarm", lambda: sink.send(dp.disarm()))
+        result.shutdown_errors.append("interrupted again while landing: disarmed at once")
 
 
 def _finish_disarm(sink: Sink, pacer: Pacer, keepalive_ms: int, result: RunResult) -> None:

@@ -322,3 +322,59 @@ def test_pulled_cable_mid_flight_reconnects_and_lands(virtual_drone: Path, monke
     assert not r.final_laser and not r.final_armed and not r.final_fc_armed and r.final_altitude == 0.0
     assert r.crashes == 0 and r.wall_hits == 0
     assert not r.fired  # it did not go on to fire at the target with a rebooted board
+
+
+def test_second_interrupt_while_landing_disarms_at_once() -> None:
+    """Ctrl-C, then Ctrl-C again during the landing: laser off and neutral were sent, then disarm, and out."""
+    from pilot.config import ControllerConfig
+
+    class Clock:
+        t = 0.0
+
+        def now(self) -> float:
+            return self.t
+
+        def wait_tick(self) -> None:
+            self.t += 0.05
+
+    clock = Clock()
+    wire: list[bytes] = []
+
+    class Sink:
+        def send(self, frame: bytes) -> bool:
+            wire.append(frame)
+            if dp.decode(frame).name == "move_down" and sum(dp.decode(f).name == "move_down" for f in wire) == 3:
+                raise KeyboardInterrupt  # the second Ctrl-C, after three frames of the landing
+            return True
+
+        def poll(self) -> list[dp.Reply]:
+            return []
+
+    class Frames:
+        def read(self) -> Frame:
+            if clock.t > 8.0:
+                raise KeyboardInterrupt  # the first Ctrl-C, in flight
+            return Frame(np.zeros((240, 320, 3), np.uint8), clock.t, 0)
+
+        def close(self) -> None:
+            pass
+
+        def __enter__(self) -> Frames:
+            return self
+
+        def __exit__(self, *exc: object) -> None:
+            pass
+
+    class Seen:
+        name = "fake"
+
+        def detect(self, image: np.ndarray) -> Detection:
+            return Detection(True, 200.0, 120.0, 10.0, 1.0, 320, 240)  # seen off to the right: it keeps turning
+
+    controller = Controller(ControllerConfig(), clock=clock.now)
+    result = run(Frames(), Seen(), controller, Sink(), clock, max_seconds=60, keepalive_ms=200)
+    assert isinstance(result.error, KeyboardInterrupt)
+    sent = names(wire)
+    tail = sent[sent.index("servo_reset") - 1 :]
+    assert tail == ["hold_altitude", "servo_reset", "move_down", "move_down", "move_down", "disarm"]
+    assert any("interrupted again" in e for e in result.shutdown_errors)
