@@ -131,8 +131,11 @@ class Recorder:
         if len(points) >= 2:
             cv2.polylines(img, [points], False, (200, 80, 0), 2)
             cv2.circle(img, (int(points[-1][0]), int(points[-1][1])), 5, (200, 80, 0), -1)
-        label = f"{scenario.name} seed {scenario.seed}"
+        label = f"{scenario.name} seed {scenario.seed}: start (green), path (blue), target (red), distractors"
         cv2.putText(img, label, (margin, margin - 5), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (0, 0, 0), 1)
+        cv2.putText(
+            img, f"{room.width:g} x {room.depth:g} m", (margin, h - 5), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (90, 90, 90), 1
+        )
         cv2.imwrite(str(self.path_picture), img)
         return self.path_picture
 
