@@ -47,6 +47,13 @@ inline uint8_t read_byte(const uint8_t* p) {
 #endif
 }
 inline char read_char(const char* p) { return static_cast<char>(read_byte(reinterpret_cast<const uint8_t*>(p))); }
+inline void read_block(void* out, const void* p, size_t size) {
+#ifdef __AVR__
+  memcpy_P(out, p, size);
+#else
+  memcpy(out, p, size);
+#endif
+}
 inline uint16_t read_word(const uint16_t* p) {
 #ifdef __AVR__
   return pgm_read_word(p);
@@ -338,11 +345,7 @@ inline ChannelLimits channel_limits(Target target) {
   ChannelLimits limits{0, 0, 0, 0, 0};
   const uint8_t i = static_cast<uint8_t>(static_cast<uint8_t>(target) - 1u);
   if (i < detail::CHANNEL_COUNT) {
-#ifdef __AVR__
-    memcpy_P(&limits, &detail::CHANNELS[i], sizeof limits);
-#else
-    memcpy(&limits, &detail::CHANNELS[i], sizeof limits);
-#endif
+    detail::read_block(&limits, &detail::CHANNELS[i], sizeof limits);
   }
   return limits;
 }
@@ -350,11 +353,7 @@ inline ChannelLimits channel_limits(Target target) {
 // What the spec says of a command (copied out of flash).
 inline CommandInfo command_info(CommandId id) {
   CommandInfo info;
-#ifdef __AVR__
-  memcpy_P(&info, &detail::COMMANDS[static_cast<uint8_t>(id)], sizeof info);
-#else
-  memcpy(&info, &detail::COMMANDS[static_cast<uint8_t>(id)], sizeof info);
-#endif
+  detail::read_block(&info, &detail::COMMANDS[static_cast<uint8_t>(id)], sizeof info);
   return info;
 }
 
