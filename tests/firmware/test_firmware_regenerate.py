@@ -38,6 +38,7 @@ def test_a_direction_added_to_the_spec_is_accepted_by_the_rebuilt_firmware(tmp_p
     header = (library / "src" / "DroneProtocol.h").read_text()
     assert "'m', 'g'" in header
     build = tmp_path / "build"
+    fw.make("firmware-sim")  # the simavr harness, which this test may be the first to need
     # Cores are shared with the main build (FW_CORE_BUILD): only the sketch is rebuilt.
     fw.make(
         str(build / "uno" / "uno.elf"),
