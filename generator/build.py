@@ -5,7 +5,6 @@ from __future__ import annotations
 import difflib
 import hashlib
 import json
-import re
 from pathlib import Path
 from typing import TypeVar
 
@@ -13,6 +12,7 @@ from generator import __version__
 from generator.errors import SpecError, SpecInvalid
 from generator.model import Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
 from generator.names import identifier_problem
+from generator.reader import Reader, is_int, kind_name
 from generator.source import INVALID, Node, load
 
 T = TypeVar("T")
@@ -26,106 +26,6 @@ STREAM_ERRORS = PARSER_ERRORS[:5]
 FRAME_ERRORS = tuple(e for e in PARSER_ERRORS if e != "timeout")
 REPLIES = ("ready", "accepted", "rejected", "failsafe")
 SPEED_LABELS = ("low", "median", "high")
-_BAD_TEXT = re.compile(r"[\x00-\x1f\x7f\\]|\?\?|\"\"\"")
-
-
-class Reader:
-    """Typed access to one mapping of the spec; records errors instead of raising."""
-
-    def __init__(self, node: Node, path: str, errors: list[SpecError]) -> None:
-        self.node, self.path, self.errors = node, path, errors
-        self.seen: set[str] = set()
-        self.ok = isinstance(node.value, dict)
-        if not self.ok and node.value is not INVALID:
-            self.error(node, f"expected a mapping, found {_kind(node.value)}")
-
-    def sub(self, key: str) -> str:
-        return f"{self.path}.{key}" if self.path else key
-
-    def error(self, node: Node, message: str, hint: str = "", path: str | None = None) -> None:
-        self.errors.append(SpecError(node.location, self.path if path is None else path, message, hint))
-
-    def child(self, key: str, required: bool = True) -> Node | None:
-        self.seen.add(key)
-        if not self.ok:
-            return None
-        node = self.node.children.get(key)
-        if node is None and required:
-            self.error(self.node, f"missing key '{key}'", path=self.sub(key))
-        return node
-
-    def get(self, key: str, kind: type[T], default: T | None = None, required: bool = True) -> T | None:
-        node = self.child(key, required and default is None)
-        if node is None:
-            return default
-        value = node.value
-        if value is INVALID:
-            return default
-        if (kind is int and isinstance(value, bool)) or not isinstance(value, kind):
-            self.error(node, f"expected {_type_name(kind)}, found {_kind(value)} {value!r}", path=self.sub(key))
-            return default
-        if isinstance(value, str) and kind is str:
-            problem = text_problem(value)
-            if problem:
-                self.error(node, problem, "write plain text; it is printed into C++ and Python code",
-                           path=self.sub(key))
-                return default
-        return value  # type: ignore[return-value]  # isinstance(value, kind) was checked above
-
-    def text(self, key: str, default: str | None = None) -> str:
-        value = self.get(key, str, default)
-        return " ".join(value.split()) if value is not None else ""
-
-    def integer(self, key: str, default: int | None = None) -> int:
-        value = self.get(key, int, default)
-        return value if value is not None else 0
-
-    def section(self, key: str) -> Reader:
-        """A required mapping; when it is missing (reported once), a reader that yields defaults silently."""
-        node = self.child(key)
-        if node is None:
-            node = Node(INVALID, self.node.location, self.node.location)
-        return Reader(node, self.sub(key), self.errors)
-
-    def entries(self, key: str) -> list[tuple[str, Node]]:
-        node = self.child(key)
-        if node is None:
-            return []
-        if not isinstance(node.value, dict):
-            if node.value is not INVALID:
-                self.error(node, f"expected a mapping, found {_kind(node.value)}", path=self.sub(key))
-            return []
-        if not node.children:
-            self.error(node, "must not be empty", path=self.sub(key))
-        return list(node.children.items())
-
-    def finish(self) -> None:
-        """Report keys nobody asked for, with the nearest known key as a hint."""
-        if not self.ok:
-            return
-        for key, node in self.node.children.items():
-            if key not in self.seen:
-                near = difflib.get_close_matches(key, sorted(self.seen), n=1)
-                hint = f"did you mean '{near[0]}'?" if near else "known keys: " + ", ".join(sorted(self.seen))
-                self.errors.append(SpecError(node.key_location, self.sub(key), f"unknown key '{key}'", hint))
-
-
-def text_problem(value: str) -> str | None:
-    bad = _BAD_TEXT.search(value.replace("\n", " "))
-    if bad is None:
-        return None
-    return f"text contains {bad.group()!r}, which could break out of a comment or string in generated code"
-
-
-def _kind(value: object) -> str:
-    if value is None:
-        return "nothing"
-    return {bool: "a boolean", int: "an integer", float: "a number", str: "text", list: "a list",
-            dict: "a mapping"}.get(type(value), type(value).__name__)
-
-
-def _type_name(kind: type) -> str:
-    return {int: "an integer", str: "text", bool: "a boolean", list: "a list", dict: "a mapping"}[kind]
 
 
 def fingerprint(value: object) -> str:
@@ -178,7 +78,7 @@ class _Builder:
         if encoding is not None and encoding != "ascii":
             frame.error(frame.node.children["encoding"], f"unsupported encoding '{encoding}'", "only ascii",
                         frame.sub("encoding"))
-        if _is_int(frame.node.children.get("length")) and not 3 <= length <= 6:
+        if is_int(frame.node.children.get("length")) and not 3 <= length <= 6:
             frame.error(frame.node.children["length"], f"frame length {length} is not in 3..6",
                         "a frame is category, direction and 1 to 4 value digits (16-bit values on the Arduino)",
                         frame.sub("length"))
@@ -257,7 +157,7 @@ class _Builder:
     def _positive(self, reader: Reader, key: str) -> int:
         value = reader.integer(key)
         node = reader.node.children.get(key) if reader.ok else None
-        if node is not None and _is_int(node) and value <= 0:
+        if node is not None and is_int(node) and value <= 0:
             reader.error(node, f"{key} must be positive, found {value}", path=reader.sub(key))
         return value
 
@@ -576,7 +476,7 @@ class _Builder:
         if not isinstance(node.value, list):
             if node.value is INVALID:
                 return []
-            top.error(node, f"expected a list, found {_kind(node.value)}", path="settled")
+            top.error(node, f"expected a list, found {kind_name(node.value)}", path="settled")
             return []
         out = []
         for i, item in enumerate(node.items):
@@ -585,10 +485,6 @@ class _Builder:
                 out.append(Settled(r.text("title"), r.text("seed"), r.text("decision")))
                 r.finish()
         return out
-
-
-def _is_int(node: Node | None) -> bool:
-    return node is not None and isinstance(node.value, int) and not isinstance(node.value, bool)
 
 
 def _is_code(code: str) -> bool:
