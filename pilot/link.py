@@ -19,12 +19,12 @@ import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
-from types import TracebackType
 from typing import Any, Self
 
 import drone_protocol as dp
 import serial
 
+from pilot.closing import Closing
 from pilot.errors import FingerprintMismatch, LinkError, ReadyTimeout
 
 MAX_LINE = 128
@@ -63,7 +63,7 @@ def keepalive_ms(fraction: float) -> int:
     return max(1, int(dp.COMMAND_TIMEOUT_MS * fraction))
 
 
-class Link:
+class Link(Closing):
     def __init__(
         self,
         port: str | Any,
@@ -260,10 +260,5 @@ class Link:
         self._close_port()
         self._note("link", "closed")
 
-    def __enter__(self) -> Self:
+    def __enter__(self) -> Self:  # opens the port, unlike Closing's
         return self if self._opened else self.open()
-
-    def __exit__(
-        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
-    ) -> None:
-        self.close()

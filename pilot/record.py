@@ -12,13 +12,13 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from types import TracebackType
-from typing import Any, Self
+from typing import Any
 
 import cv2
 import drone_protocol as dp
 import numpy as np
 
+from pilot.closing import Closing
 from pilot.link import LogEntry
 from pilot.runner import Tick
 from pilot.sim.room import Scenario
@@ -32,7 +32,7 @@ def _reply_text(reply: dp.Reply) -> str:
     return reply.kind.name + (reply.category or "") + (reply.direction or "") + (reply.error or "")
 
 
-class Recorder:
+class Recorder(Closing):
     def __init__(self, directory: str | Path, fps: float = 20.0) -> None:
         self.dir = Path(directory)
         self.dir.mkdir(parents=True, exist_ok=True)
@@ -147,10 +147,3 @@ class Recorder:
             self._writer.release()
         self._log.close()
 
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(
-        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
-    ) -> None:
-        self.close()

@@ -17,6 +17,7 @@ from typing import Protocol, Self
 import cv2
 from cv2.typing import MatLike
 
+from pilot.closing import Closing
 from pilot.errors import FrameSourceError
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".ppm", ".pgm", ".tif", ".tiff")
@@ -41,7 +42,9 @@ class FrameSource(Protocol):
     ) -> None: ...
 
 
-class _Base:
+class FrameSourceBase(Closing):
+    """Frame numbering and the closed flag of every source."""
+
     def __init__(self, time_fn: Callable[[], float]) -> None:
         self._time_fn = time_fn
         self._index = 0
@@ -55,16 +58,9 @@ class _Base:
     def close(self) -> None:
         self._closed = True
 
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(
-        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
-    ) -> None:
-        self.close()
 
 
-class CameraSource(_Base):
+class CameraSource(FrameSourceBase):
     """A V4L2/OpenCV camera (index or device path) with a one-frame buffer, so that decisions use
     the newest image rather than one up to ~130 ms old. ``max_failures`` consecutive failed reads
     mean the camera is lost."""
@@ -102,7 +98,7 @@ class CameraSource(_Base):
         super().close()
 
 
-class VideoFileSource(_Base):
+class VideoFileSource(FrameSourceBase):
     """Frames of a video file, in order; ``None`` at the end."""
 
     def __init__(self, path: str | Path, time_fn: Callable[[], float] = time.monotonic) -> None:
@@ -128,7 +124,7 @@ class VideoFileSource(_Base):
         super().close()
 
 
-class ImageFolderSource(_Base):
+class ImageFolderSource(FrameSourceBase):
     """The images of a folder in name order; ``None`` after the last."""
 
     def __init__(self, folder: str | Path, time_fn: Callable[[], float] = time.monotonic) -> None:

@@ -15,9 +15,9 @@ import os
 import subprocess
 from dataclasses import dataclass
 from pathlib import Path
-from types import TracebackType
-from typing import IO, Any, Self
+from typing import IO, Any
 
+from pilot.closing import Closing
 from pilot.errors import SimulatorError
 from pilot.sim.model import Outputs
 
@@ -61,7 +61,7 @@ def _outputs(d: dict[str, Any]) -> Outputs:
         raise SimulatorError(f"virtual drone: unexpected output line {d!r} ({exc})") from exc
 
 
-class VirtualDrone:
+class VirtualDrone(Closing):
     def __init__(self, executable: str | Path | None = None) -> None:
         exe = find_executable(executable)
         self._proc = subprocess.Popen(
@@ -136,10 +136,3 @@ class VirtualDrone:
                 if stream is not None:
                     stream.close()
 
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(
-        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
-    ) -> None:
-        self.close()

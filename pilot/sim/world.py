@@ -10,15 +10,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from types import TracebackType
-from typing import Self
 
+from pilot.closing import Closing
 from pilot.errors import FrameSourceError, SimulatorError
 from pilot.sim.camera import CameraModel, CameraPose, Image, Renderer
 from pilot.sim.model import DroneModel, ModelParams, Outputs, StickCentres
 from pilot.sim.room import Scenario
 from pilot.sim.virtual import VirtualDrone
-from pilot.sources import Frame
+from pilot.sources import Frame, FrameSourceBase
 
 BOOT_MS = 20  # the firmware boots and sends its ready line (39 bytes at 115200 baud: under 4 ms)
 
@@ -33,7 +32,7 @@ class FlightScore:
     max_altitude: float = 0.0
 
 
-class SimWorld:
+class SimWorld(Closing):
     def __init__(
         self,
         scenario: Scenario,
@@ -152,22 +151,14 @@ class SimWorld:
     def close(self) -> None:
         self.vd.close()
 
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(
-        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
-    ) -> None:
-        self.close()
 
 
-class SimCamera:
+class SimCamera(FrameSourceBase):
     """The frame source of the simulated room: the view from the drone's current pose."""
 
     def __init__(self, world: SimWorld) -> None:
+        super().__init__(world.now)
         self.world = world
-        self._index = 0
-        self._closed = False
 
     def read(self) -> Frame | None:
         w = self.world
@@ -175,17 +166,4 @@ class SimCamera:
             raise FrameSourceError("simulated camera: read after close")
         if w.lose_camera_at_s is not None and w.now() >= w.lose_camera_at_s:
             raise FrameSourceError(f"simulated camera lost at t={w.now():.2f} s")
-        frame = Frame(w.render(), w.now(), self._index)
-        self._index += 1
-        return frame
-
-    def close(self) -> None:
-        self._closed = True
-
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(
-        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
-    ) -> None:
-        self.close()
+        return self._frame(w.render())
