@@ -143,12 +143,9 @@ class Link(Closing):
         deadline = self._ready_clock() + limit
         while True:
             for line in self._read_lines():
-                try:
-                    reply = dp.parse_reply(line)
-                except dp.ProtocolError:
-                    self._note("rx-garbage", line.decode("ascii", "replace"))
+                reply = self._parse(line)
+                if reply is None:
                     continue
-                self._note("rx", line.decode("ascii", "replace").rstrip())
                 if reply.kind is dp.ReplyKind.READY:
                     if reply.fingerprint != dp.SPEC_FINGERPRINT or reply.protocol != dp.PROTOCOL_NAME:
                         theirs = f"{reply.protocol} {reply.fingerprint}"
@@ -209,15 +206,21 @@ class Link(Closing):
             return []
         out: list[dp.Reply] = []
         for line in lines:
-            try:
-                reply = dp.parse_reply(line)
-            except dp.ProtocolError:
-                self._note("rx-garbage", line.decode("ascii", "replace"))
-                continue
-            self._note("rx", line.decode("ascii", "replace").rstrip())
-            out.append(reply)
+            reply = self._parse(line)
+            if reply is not None:
+                out.append(reply)
         self.replies.extend(out)
         return out
+
+    def _parse(self, line: bytes) -> dp.Reply | None:
+        """A reply line, logged; None (logged as garbage) when it is not one of the spec's replies."""
+        try:
+            reply = dp.parse_reply(line)
+        except dp.ProtocolError:
+            self._note("rx-garbage", line.decode("ascii", "replace"))
+            return None
+        self._note("rx", line.decode("ascii", "replace").rstrip())
+        return reply
 
     def _recover(self) -> bool:
         """Close and reopen the port within ``reconnect_s``; wait for the ready line again."""
