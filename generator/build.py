@@ -114,7 +114,7 @@ class _Builder:
                          "a movement must end before the failsafe fires", safety.sub("command_timeout_ms"))
         safety.finish()
 
-        categories = self._categories(top, fields, channels, servos, length)
+        categories = self._categories(top, fields, channels, servos)
         replies = self._replies(top)
         errors = self._errors(top)
         settled = self._settled(top)
@@ -258,7 +258,7 @@ class _Builder:
         return fields
 
     def _categories(self, top: Reader, fields: dict[str, tuple[Field, tuple[int, int] | None, int | None, Node]],
-                    channels: dict[str, Channel], servos: dict[str, Servo], length: int) -> list[Category]:
+                    channels: dict[str, Channel], servos: dict[str, Servo]) -> list[Category]:
         categories: list[Category] = []
         commands: dict[str, str] = {}
         for code, node in top.entries("categories"):
@@ -288,7 +288,7 @@ class _Builder:
             directions = []
             entries = r.entries("directions")
             for dcode, dnode in entries:
-                d = self._direction(r, code, dcode, dnode, prefix, default_field, filler_code, fields, channels,
+                d = self._direction(r, dcode, dnode, prefix, default_field, filler_code, fields, channels,
                                     servos)
                 if d is None:
                     continue
@@ -321,7 +321,7 @@ class _Builder:
         hint = f"did you mean '{near[0]}'?" if near else "known: " + ", ".join(sorted(known))
         r.error(r.node.children[key], f"unknown {key} '{value}'", hint, r.sub(key))
 
-    def _direction(self, cat: Reader, code: str, dcode: str, node: Node, prefix: str | None, default_field: str | None,
+    def _direction(self, cat: Reader, dcode: str, node: Node, prefix: str | None, default_field: str | None,
                    filler_code: str | None, fields: dict[str, tuple[Field, tuple[int, int] | None, int | None, Node]],
                    channels: dict[str, Channel], servos: dict[str, Servo]) -> Direction | None:
         path = f"{cat.path}.directions.{dcode}"

@@ -195,9 +195,6 @@ class Spec:
     def reply(self, name: str) -> Reply:
         return next(r for r in self.replies if r.name == name)
 
-    def channel(self, name: str) -> Channel:
-        return next(c for c in self.channels if c.name == name)
-
     @property
     def digits_width(self) -> int:
         return self.frame_length - 2

@@ -316,10 +316,14 @@ inline int8_t find_command(uint8_t category, uint8_t direction) {
 
 inline bool is_category(uint8_t byte) { return find_category(byte) >= 0; }
 
-// Is byte `pos` of `frame` valid, given that the bytes before it are? Returns the error it causes.
-inline Error check_byte(const uint8_t* frame, uint8_t pos) {
+// Is byte `pos` of `frame` valid, given that the bytes before it are? Returns the error it causes; at
+// byte 1, sets `index` to the frame's command.
+inline Error check_byte(const uint8_t* frame, uint8_t pos, int8_t& index) {
   if (pos == 0) return is_category(frame[0]) ? Error::None : Error::BadCategory;
-  if (pos == 1) return find_command(frame[0], frame[1]) >= 0 ? Error::None : Error::BadDirection;
+  if (pos == 1) {
+    index = find_command(frame[0], frame[1]);
+    return index >= 0 ? Error::None : Error::BadDirection;
+  }
   return (frame[pos] >= '0' && frame[pos] <= '9') ? Error::None : Error::BadDigit;
 }
 
@@ -403,11 +407,12 @@ inline const char* command_name(CommandId id) {
 inline Error decode(const uint8_t* frame, size_t length, Command& out) {
   if (length < FRAME_LENGTH) return Error::TooShort;
   if (length > FRAME_LENGTH) return Error::TooLong;
+  int8_t index = -1;
   for (uint8_t pos = 0; pos < FRAME_LENGTH; ++pos) {
-    const Error error = detail::check_byte(frame, pos);
+    const Error error = detail::check_byte(frame, pos, index);
     if (error != Error::None) return error;
   }
-  return detail::finish(frame, detail::find_command(frame[0], frame[1]), out);
+  return detail::finish(frame, index, out);
 }
 
 inline Error decode(const uint8_t frame[FRAME_LENGTH], Command& out) { return decode(frame, FRAME_LENGTH, out); }
@@ -491,7 +496,7 @@ class StreamParser {
     uint8_t from = static_cast<uint8_t>(length_ - 1);
     while (length_ > 0) {
       Error error = Error::None;
-      for (uint8_t pos = from; pos < length_ && error == Error::None; ++pos) error = check(pos);
+      for (uint8_t pos = from; pos < length_ && error == Error::None; ++pos) error = detail::check_byte(buffer_, pos, index_);
       if (error == Error::None && length_ == FRAME_LENGTH) error = detail::finish(buffer_, index_, command_);
       if (error == Error::None) {
         if (length_ < FRAME_LENGTH) return false;
@@ -504,16 +509,6 @@ class StreamParser {
       from = 0;
     }
     return false;
-  }
-
-  // Byte `pos` given that the bytes before it are valid; remembers the command found at byte 1.
-  Error check(uint8_t pos) {
-    if (pos == 0) return detail::is_category(buffer_[0]) ? Error::None : Error::BadCategory;
-    if (pos == 1) {
-      index_ = detail::find_command(buffer_[0], buffer_[1]);
-      return index_ >= 0 ? Error::None : Error::BadDirection;
-    }
-    return (buffer_[pos] >= '0' && buffer_[pos] <= '9') ? Error::None : Error::BadDigit;
   }
 
   void count(Error error) {
