@@ -10,8 +10,7 @@ from typing import TypeVar
 
 from generator import __version__
 from generator.errors import SpecError, SpecInvalid
-from generator.model import (INTEGRITY_MODES, Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled,
-                             Spec)
+from generator.model import INTEGRITY_MODES, Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
 from generator.names import identifier_problem
 from generator.reader import Reader, is_int, kind_name
 from generator.source import INVALID, Node, load

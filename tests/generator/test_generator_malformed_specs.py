@@ -163,7 +163,8 @@ CASES = [
     Case("Python reserved word", (("        name: forward", "        name: class"),),
          (("class", f"categories.m.directions.f.name: 'class' is a reserved word in a target language {IDENT_HINT}"),)),
     Case("Python soft keyword", (("        name: forward", "        name: match"),),
-         (("name: ^match", f"categories.m.directions.f.name: 'match' is a reserved word in a target language {IDENT_HINT}"),)),
+         (("name: ^match",
+           f"categories.m.directions.f.name: 'match' is a reserved word in a target language {IDENT_HINT}"),)),
     Case("C++ reserved word", (("        name: forward", "        name: delete"),),
          (("delete",
            f"categories.m.directions.f.name: 'delete' is a reserved word in a target language {IDENT_HINT}"),)),
@@ -262,7 +263,8 @@ CASCADES = [
          (("        name: toggle\n", "        name: toggle\n        default: 5\n"),),
          (("default: ^5", "categories.l.directions.0.default: default 5 is outside range 0..0"),)),
     Case("empty directions",
-         (('    directions:\n      "0":\n        name: toggle\n        description: Toggle the laser (the seed\'s frame)\n'
+         (('    directions:\n      "0":\n        name: toggle\n'
+           '        description: Toggle the laser (the seed\'s frame)\n'
            '      "n":\n        name: "on"\n        description: Switch the laser on\n'
            '      f:\n        name: "off"\n        description: Switch the laser off\n',
            "    directions: {}\n"),),
