@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import Enum, StrEnum
 from types import MappingProxyType
 from typing import Final
@@ -64,6 +64,9 @@ __all__ = [
     "first_test",
     "land",
     "ReplyKind", "Reply", "parse_reply", "ready_line", "accepted_line", "rejected_line", "failsafe_line",
+    # >>> pilotsafe (temporary, until the lead's codec API lands on main): typed names and the reply status
+    "CommandName", "ChannelName", "ServoName", "DroneState", "ARMED_STATES", "LANDING_MS", "status_suffix",
+    # <<< pilotsafe
 ]
 
 # The spec's fingerprint: both ends of the link compare it (the Arduino prints it in its ready line).
@@ -808,6 +811,10 @@ class Reply:
     error: ErrorKind | None = None
     protocol: str = ""
     fingerprint: str = ""
+    # >>> pilotsafe (temporary): the drone's status after the reply (None on the ready line)
+    state: DroneState | None = None
+    laser: bool | None = None
+    # <<< pilotsafe
 
 
 # Longest prefix first; the spec guarantees no prefix starts another.
@@ -828,6 +835,13 @@ def parse_reply(line: bytes) -> Reply:
     known = _KNOWN_REPLIES.get(line.rstrip(b"\r\n"))
     if known is not None:
         return known
+    # >>> pilotsafe (temporary): the status suffix of accepted, rejected and failsafe lines
+    body, state, laser = _split_status(line.rstrip(b"\r\n"))
+    if state is not None:
+        known = _KNOWN_REPLIES.get(body)
+        if known is not None:
+            return replace(known, state=state, laser=laser)
+    # <<< pilotsafe
     text = line.rstrip(b"\r\n").decode("ascii", errors="replace")
     for kind in _REPLY_PREFIXES:
         if not text.startswith(kind.value):
@@ -864,3 +878,103 @@ def rejected_line(error: ErrorKind) -> bytes:
 
 def failsafe_line() -> bytes:
     return f"{ReplyKind.FAILSAFE.value}\n".encode("ascii")
+
+
+# >>> pilotsafe (temporary, until the lead's codec API lands on main) ------------------------------------------
+#: The landing routine's descent time, before its disarm sequence.
+LANDING_MS: Final = 4000
+
+
+class CommandName(StrEnum):
+    """Every command of the spec, by name: a rename in the spec is a type error in code that uses one."""
+
+    MOVE_FORWARD = "move_forward"
+    MOVE_BACKWARD = "move_backward"
+    MOVE_LEFT = "move_left"
+    MOVE_RIGHT = "move_right"
+    MOVE_UP = "move_up"
+    MOVE_DOWN = "move_down"
+    TURN_LEFT = "turn_left"
+    TURN_RIGHT = "turn_right"
+    SERVO_UP = "servo_up"
+    SERVO_DOWN = "servo_down"
+    SERVO_LEFT = "servo_left"
+    SERVO_RIGHT = "servo_right"
+    SERVO_RESET = "servo_reset"
+    LASER_TOGGLE = "laser_toggle"
+    LASER_ON = "laser_on"
+    LASER_OFF = "laser_off"
+    ARM = "arm"
+    DISARM = "disarm"
+    HOLD_ALTITUDE = "hold_altitude"
+    FIRST_TEST = "first_test"
+    LAND = "land"
+
+
+class ChannelName(StrEnum):
+    YAW = "yaw"
+    ROLL = "roll"
+    PITCH = "pitch"
+    THROTTLE = "throttle"
+
+
+class ServoName(StrEnum):
+    PAN = "pan"
+    TILT = "tilt"
+
+
+class DroneState(StrEnum):
+    """The drone's state as every reply reports it; the value is its code letter."""
+
+    #: Disarmed; movements are refused
+    DISARMED = "d"
+    #: The arming sequence runs (throttle minimum, yaw right)
+    ARMING = "r"
+    #: Armed, on the ground (throttle minimum)
+    ARMED = "a"
+    #: Holding altitude, sticks neutral
+    HOLD_ALTITUDE = "h"
+    #: A movement or turn runs until safety.command_timeout_ms
+    MOVING = "m"
+    #: The landing routine descends, then disarms
+    LANDING = "l"
+    #: The disarm sequence runs (throttle minimum, yaw left)
+    DISARMING = "k"
+    #: The self-test runs (servo sweep, laser blinks)
+    SELF_TEST = "t"
+    #: No valid frame for safety.failsafe_timeout_ms: failsafe throttle, laser off; the flight controller
+    #: lands and disarms itself, and the firmware needs a new arming sequence
+    FAILSAFE = "f"
+
+
+#: The states in which the motors may spin.
+ARMED_STATES: Final[frozenset[DroneState]] = frozenset({
+    DroneState.ARMED,
+    DroneState.HOLD_ALTITUDE,
+    DroneState.MOVING,
+    DroneState.LANDING,
+    DroneState.DISARMING,
+})
+_STATUS_SEPARATOR: Final = " "
+_LASER_CODES: Final[Mapping[str, bool]] = {
+    "0": False, "1": True,
+}
+
+
+def _split_status(line: bytes) -> tuple[bytes, DroneState | None, bool | None]:
+    """A reply line without its status suffix, and the state and laser it reports (None, None: no suffix)."""
+    cut = len(line) - len(_STATUS_SEPARATOR) - 2
+    if cut < 1 or line[cut:cut + len(_STATUS_SEPARATOR)] != _STATUS_SEPARATOR.encode("ascii"):
+        return line, None, None
+    state = DroneState._value2member_map_.get(chr(line[-2]))
+    laser = _LASER_CODES.get(chr(line[-1]))
+    if not isinstance(state, DroneState) or laser is None:
+        return line, None, None
+    return line[:cut], state, laser
+
+
+def status_suffix(state: DroneState, laser: bool) -> bytes:
+    """The status a reply line carries, for fakes and tests of the other end."""
+    code = "1" if laser else "0"
+    return f"{_STATUS_SEPARATOR}{state.value}{code}".encode("ascii")
+# <<< pilotsafe ---------------------------------------------------------------------------------------------
