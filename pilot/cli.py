@@ -109,7 +109,8 @@ class _StillSim:
         self.scenario = make_scenario(scenario_name, seed)
         self.renderer = Renderer(self.scenario, CameraModel(*size))
         x, y, heading = self.scenario.start
-        self.pose = CameraPose.from_drone(x, y, 1.2, heading, dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default)
+        pan, tilt = dp.SERVOS[dp.ServoName.PAN], dp.SERVOS[dp.ServoName.TILT]
+        self.pose = CameraPose.from_drone(x, y, 1.2, heading, pan.default, tilt.default)
         self._index = 0
 
     def read(self) -> Frame | None:

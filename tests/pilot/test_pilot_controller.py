@@ -85,7 +85,7 @@ def test_arm_takeoff_hold_search_timing() -> None:
     out = tick(c, clock, MISS)
     assert st(c) is State.TAKEOFF and name(out) == "move_up"
     assert out is not None
-    assert (dp.decode(out).value or 0) > dp.CHANNELS["throttle"].median
+    assert (dp.decode(out).value or 0) > dp.CHANNELS[dp.ChannelName.THROTTLE].median
     for _ in range(CFG.takeoff_ms // 50 - 1):
         assert name(tick(c, clock, MISS)) == "move_up"
     assert name(tick(c, clock, MISS)) == "hold_altitude" and st(c) is State.HOLD
@@ -186,7 +186,7 @@ def test_turn_speed_grows_with_the_error() -> None:
     small = dp.decode(tick(c, clock, seen(0.15)) or b"").value
     large = dp.decode(tick(c, clock, seen(0.9)) or b"").value
     assert small is not None and large is not None
-    assert dp.CHANNELS["yaw"].median < small < large
+    assert dp.CHANNELS[dp.ChannelName.YAW].median < small < large
 
 
 def test_track_to_aim_with_size_hysteresis() -> None:

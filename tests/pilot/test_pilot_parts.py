@@ -23,7 +23,7 @@ from pilot.sim.model import DroneModel, Outputs, StickCentres
 from pilot.sim.room import SCENARIOS, Room, make_scenario
 from pilot.sources import CameraSource, ImageFolderSource, VideoFileSource
 
-PAN0, TILT0 = dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default
+PAN0, TILT0 = dp.SERVOS[dp.ServoName.PAN].default, dp.SERVOS[dp.ServoName.TILT].default
 
 # -- config --------------------------------------------------------------------------------------------
 
@@ -180,8 +180,8 @@ def neutral(**kw: int | bool) -> Outputs:
         "throttle": ch["throttle"].median,
         "yaw": ch["yaw"].median,
         "mode": 0,
-        "pan": dp.SERVOS["pan"].default,
-        "tilt": dp.SERVOS["tilt"].default,
+        "pan": dp.SERVOS[dp.ServoName.PAN].default,
+        "tilt": dp.SERVOS[dp.ServoName.TILT].default,
         "laser": False,
         "armed": True,  # the firmware's flag: the model does not read it
     }

@@ -182,9 +182,9 @@ def test_fault_in_any_stage_ends_laser_off_neutral_disarmed(stage: str, virtual_
     assert out.laser is False and out.armed is False
     assert f.world.fw_state == "disarmed"
     assert (out.roll, out.pitch, out.yaw) == (
-        dp.CHANNELS["roll"].median,
-        dp.CHANNELS["pitch"].median,
-        dp.CHANNELS["yaw"].median,
+        dp.CHANNELS[dp.ChannelName.ROLL].median,
+        dp.CHANNELS[dp.ChannelName.PITCH].median,
+        dp.CHANNELS[dp.ChannelName.YAW].median,
     )
     assert f.world.model.state.z == 0.0 and f.world.model.state.crashes == 0
     assert not f.world.model.state.armed  # the flight controller saw the disarm sticks
