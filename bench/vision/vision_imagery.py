@@ -68,9 +68,17 @@ def _disc_alpha(cx: float, cy: float, r: float, shape: tuple[int, int]) -> tuple
     return alpha, dx, dy
 
 
+def _window(img: Image, cx: float, cy: float, r: float) -> tuple[Image, float, float]:
+    """The part of the image a disc can touch (a view: drawing into it draws into the image)."""
+    x0, y0 = max(0, int(cx - r - 2)), max(0, int(cy - r - 2))
+    x1, y1 = min(img.shape[1], int(cx + r + 3)), min(img.shape[0], int(cy + r + 3))
+    return img[y0:y1, x0:x1], cx - x0, cy - y0
+
+
 def shaded_ball(img: Image, cx: float, cy: float, diameter: float, rng: np.random.Generator) -> None:
     """A matte red ball, lit from a random direction: Lambert shading, ambient light, a soft highlight."""
     r = diameter / 2.0
+    img, cx, cy = _window(img, cx, cy, r)
     hue = float(rng.uniform(-4.0, 4.0))  # OpenCV hue units around red
     base = np.asarray(cv2.cvtColor(np.array([[[hue % 180, rng.uniform(175, 235), rng.uniform(180, 235)]]],
                                             np.uint8), cv2.COLOR_HSV2BGR), np.float64).reshape(3)
@@ -133,6 +141,7 @@ def marker(img: Image, cx: float, cy: float, side: float, rng: np.random.Generat
 def _ball_of(img: Image, rng: np.random.Generator, hue: tuple[float, float], sat: tuple[float, float],
              val: tuple[float, float], d: float) -> None:
     cx, cy = rng.uniform(d / 2 + 2, W - d / 2 - 2), rng.uniform(d / 2 + 2, H - d / 2 - 2)
+    img, cx, cy = _window(img, cx, cy, d / 2)
     bgr = cv2.cvtColor(np.array([[[rng.uniform(*hue) % 180, rng.uniform(*sat), rng.uniform(*val)]]], np.uint8),
                        cv2.COLOR_HSV2BGR).reshape(3).astype(np.float64)
     alpha, dx, dy = _disc_alpha(cx, cy, d / 2, img.shape[:2])
