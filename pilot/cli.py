@@ -20,7 +20,7 @@ from types import FrameType
 import drone_protocol as dp
 
 from pilot import config as config_mod
-from pilot.calibrate import Roi, calibrate_to_config
+from pilot.calibrate import Roi, calibrate_to_config, preview_path
 from pilot.config import PilotConfig
 from pilot.controller import Controller, State
 from pilot.detect import make_detector
@@ -244,7 +244,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             if not args.config:
                 raise PilotError("option --calibrate needs --config FILE to save the ranges into")
             cfg = calibrate_to_config(args.calibrate, args.config, _roi(args.roi))
-            print(f"pilot: saved HSV ranges {cfg.hsv.ranges} to {args.config}")
+            print(f"pilot: saved HSV ranges {cfg.hsv.ranges} to {args.config}; preview {preview_path(args.config)}")
             return EXIT_OK
         cfg = _load_config(args)
         if args.port and args.sim:
