@@ -5,7 +5,6 @@
 
 from __future__ import annotations
 
-import math
 import re
 import time
 from collections.abc import Callable, Mapping
@@ -17,6 +16,11 @@ from .tables import FRAME_LENGTH, INTER_BYTE_TIMEOUT_MS, WIRE_LENGTH, ErrorKind
 
 # Any byte that may start a frame; a run of other bytes is one bad_category error each, counted at C speed.
 _CATEGORY_BYTE = re.compile(b"[" + b"".join(re.escape(bytes([c])) for c in BY_BYTES) + b"]")
+# Bytes shaped like a frame (a category, a direction of any category, digits): found at C speed, then checked.
+_FRAME_SHAPE = re.compile(
+    b"[" + b"".join(re.escape(bytes([c])) for c in BY_BYTES) + b"]"
+    + b"[" + b"".join(re.escape(bytes([d])) for c in BY_BYTES.values() for d in sorted(c)) + b"]"
+    + b"[0-9]" * (FRAME_LENGTH - 2))
 _LAST_DIGIT = FRAME_LENGTH - 1
 
 
@@ -47,17 +51,23 @@ class StreamDecoder:
 
     def feed(self, data: BytesLike, now: float | None = None) -> list[Command]:
         """Feed bytes that arrived together at `now` (seconds, default time_fn()); return the complete commands."""
-        if data.__class__ is not bytes:
-            if not isinstance(data, (bytearray, memoryview)):
-                raise TypeError(f"feed() takes bytes, bytearray or memoryview, not {type(data).__name__}")
-            data = bytes(data)
-        now_ms = _milliseconds(self._time_fn() if now is None else now)
+        if now is None:
+            now = self._time_fn()
+        if now.__class__ is not float or data.__class__ is not bytes:
+            data, now = _checked(data, now)
+        try:
+            # Whole milliseconds, as the Arduino counts them: a float difference would put a gap of exactly
+            # INTER_BYTE_TIMEOUT_MS on either side of the limit depending on the clock's magnitude.
+            now_ms = round(now * 1000.0)
+        except (OverflowError, ValueError):
+            raise ClockError(f"now must be a finite number of seconds, not {now!r}") from None
         pending = self._pending
         if pending and data and now_ms - self._last_ms > INTER_BYTE_TIMEOUT_MS:
             self._errors[ErrorKind.TIMEOUT] += 1
-            pending = b""
-        if data:
-            self._last_ms = now_ms
+            pending = self._pending = b""
+        if not data:
+            return []
+        self._last_ms = now_ms
         if len(data) == 1 and len(pending) < _LAST_DIGIT:
             # One byte at a time, the usual way a serial port is read: the common cases in a few steps.
             byte = data[0]
@@ -74,37 +84,56 @@ class StreamDecoder:
 
     def _scan(self, data: bytes) -> list[Command]:
         out: list[Command] = []
-        errors = self._errors
         i, n = 0, len(data)
         while i < n:
             if n - i >= WIRE_LENGTH:
                 frame = data[i:i + WIRE_LENGTH]
-                command = DECODED.get(frame) or valid(frame)
+                command = DECODED.get(frame)
+                if command is None and data[i] in BY_BYTES:
+                    command = valid(frame)
                 if command is not None:
                     out.append(command)
                     i += WIRE_LENGTH
                     continue
-            if data[i] not in BY_BYTES:
-                found = _CATEGORY_BYTE.search(data, i)
-                skip = (found.start() if found else n) - i
-                errors[ErrorKind.BAD_CATEGORY] += skip
-                i += skip
+            # No frame starts at i: everything up to the next frame-shaped bytes is garbage, counted per start.
+            shaped = _FRAME_SHAPE.search(data, i)
+            end = shaped.start() if shaped is not None else n
+            if end == i:  # frame-shaped, but out of range
+                found = problem(data, i, WIRE_LENGTH)
+                self._errors[found[0] if found is not None else ErrorKind.BAD_DIRECTION] += 1
+                i += 1
                 continue
-            found_problem = problem(data, i, min(WIRE_LENGTH, n - i))
-            if found_problem is None:
-                break  # a valid start of a frame: wait for the rest
-            errors[found_problem[0]] += 1
-            i += 1
+            i = self._garbage(data, i, end)
+            if i < end:
+                break  # the valid start of a frame at the end of the data: wait for the rest
         self._pending = data[i:]
         return out
 
+    def _garbage(self, data: bytes, start: int, end: int) -> int:
+        """Count one error per start position in data[start:end], where no whole frame starts; return where a
+        frame may still start (only in the data's last bytes), or `end`."""
+        errors = self._errors
+        i = start
+        while i < end:
+            category = _CATEGORY_BYTE.search(data, i, end)
+            at = category.start() if category is not None else end
+            errors[ErrorKind.BAD_CATEGORY] += at - i
+            if category is None:
+                return end
+            found = problem(data, at, min(WIRE_LENGTH, len(data) - at))
+            if found is None:
+                return at
+            errors[found[0]] += 1
+            i = at + 1
+        return end
 
-def _milliseconds(now: float) -> int:
-    # Whole milliseconds, as the Arduino counts them: a float difference would put a gap of exactly
-    # INTER_BYTE_TIMEOUT_MS on either side of the limit depending on the clock's magnitude.
-    if now.__class__ is not float and (isinstance(now, bool) or not isinstance(now, (int, float))):
+def _checked(data: object, now: object) -> tuple[bytes, float]:
+    """feed()'s arguments as bytes and a float, or a TypeError naming the wrong one."""
+    if isinstance(now, bool) or not isinstance(now, (int, float)):
         raise TypeError(f"now must be a number of seconds, not {type(now).__name__}")
-    ms = now * 1000.0
-    if not math.isfinite(ms):
-        raise ClockError(f"now must be a finite number of seconds, not {now!r}")
-    return round(ms)
+    if not isinstance(data, (bytes, bytearray, memoryview)):
+        raise TypeError(f"feed() takes bytes, bytearray or memoryview, not {type(data).__name__}")
+    try:
+        return bytes(data), float(now)
+    except OverflowError:
+        raise ClockError(f"now must be a finite number of seconds, not {now!r}") from None
