@@ -20,7 +20,9 @@ def _on_wire(spec: Spec, v: Vector) -> Vector:
 
 
 def _check_vectors(spec: Spec) -> list[Vector]:
-    """crc8 mode: checks that do not match, are not hex, or are lower case; and the frame one byte short."""
+    """crc8 mode: checks that do not match, are not hex, or are lower case; a digit corrupted into another in range;
+    the frame with half its check or a byte too many. Each check digit is compared as it arrives (as the C++
+    StreamParser does), so the error is at the first wrong digit, and comes before the range check."""
     if spec.integrity == "none":
         return []
     n = spec.frame_length
@@ -28,22 +30,28 @@ def _check_vectors(spec: Spec) -> list[Vector]:
     frame = first.direction.frame(first.category.code, first.direction.default_frame_value).encode()
     check = check_text(frame).encode()
     wrong = b"%02X" % ((int(check, 16) + 1) % 256)
+    def bad(given: bytes, note: str) -> Vector:  # the first check digit that differs is the error's position
+        at = next(i for i in range(len(given)) if given[i] != check[i])
+        return _invalid(frame + given, "bad_check", n + at, note)
+
     out = [
-        _invalid(frame + wrong, "bad_check", n, "a check that does not match the frame"),
-        _invalid(frame + b"g" + check[1:], "bad_check", n, "a check that is not hex"),
-        _invalid(frame + check[:1] + b"-", "bad_check", n + 1, "a check whose second digit is not hex"),
+        bad(wrong, "a check that does not match the frame"),
+        bad(b"g" + check[1:], "a check that is not hex"),
+        bad(check[:1] + b"-", "a check whose second digit is not hex"),
         _invalid(frame + check + b"0", "too_long", n + 2, "a frame and its check, one byte too many"),
         _invalid(frame + check[:1], "too_short", n + 1, "a frame missing half its check"),
     ]
     if check.lower() != check:
-        out.append(_invalid(frame + check.lower(), "bad_check", n, "a check in lower case"))
+        out.append(bad(check.lower(), "a check in lower case"))
     for pos in range(2, n):  # one corrupted value digit: still digits, so only the check catches it
         digit = frame[pos:pos + 1]
         other = b"7" if digit != b"7" else b"3"
         corrupted = frame[:pos] + other + frame[pos + 1:]
         d = first.direction
+        right = check_text(corrupted).encode()
         if d.minimum <= int(corrupted[2:]) <= d.maximum:
-            out.append(_invalid(corrupted + check, "bad_check", n, f"byte {pos} corrupted, caught by the check"))
+            at = next(i for i in range(2) if check[i] != right[i])
+            out.append(_invalid(corrupted + check, "bad_check", n + at, f"byte {pos} corrupted, caught by the check"))
             break
     return out
 
