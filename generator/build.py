@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 from typing import TypeVar
 
-from generator import __version__
+from generator import __version__, hardware
 from generator.errors import SpecError, SpecInvalid
 from generator.model import Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
 from generator.names import identifier_problem
@@ -118,6 +118,7 @@ class _Builder:
         replies = self._replies(top)
         errors = self._errors(top)
         settled = self._settled(top)
+        project, wiring = hardware.read(top, channels, list(servos), failsafe_throttle, (stabilize, alt_hold))
         top.finish()
         if self.errors:
             return None
@@ -150,6 +151,8 @@ class _Builder:
             replies=tuple(replies),
             errors=tuple(errors),
             settled=tuple(settled),
+            project=project,
+            wiring=wiring,
         )
 
     # -- helpers -------------------------------------------------------------------------------------------
