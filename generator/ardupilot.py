@@ -42,7 +42,8 @@ def parameters(spec: Spec) -> tuple[Param, ...]:
     """Every parameter of generated/ardupilot/drone.parm, in file order."""
     wiring = spec.wiring
     channels = {c.name: c for c in spec.channels}
-    out = [Param(f"RCMAP_{name.upper()}", wiring.rc_input(name), f"wiring.rc_inputs.{name}") for name in STICKS]
+    out = [Param(f"RCMAP_{name.upper()}", wiring.rc_input(name), f"wiring.rc_inputs.{name}: the RC input of {name}")
+           for name in STICKS]
     for pin in wiring.rc_inputs:
         channel = channels.get(pin.name)
         if channel is None:
@@ -54,10 +55,12 @@ def parameters(spec: Spec) -> tuple[Param, ...]:
     throttle = channels["throttle"]
     fs_value = fs_thr_value(spec.failsafe_throttle_us, throttle.recorded_min)
     assert fs_value is not None, "the spec check (generator/hardware.py) rejects a spec without the gap"
-    out += [Param("FS_THR_ENABLE", FS_THR_LAND, "safety.failsafe_throttle_us (3 = Land; RTL would climb indoors)"),
+    out += [Param("FS_THR_ENABLE", FS_THR_LAND,
+                  "safety.failsafe_throttle_us: the radio failsafe lands (3; RTL would climb indoors)"),
             Param("FS_THR_VALUE", fs_value,
-                  "between safety.failsafe_throttle_us and channels.throttle.recorded[0]")]
+                  "safety.failsafe_throttle_us < FS_THR_VALUE < channels.throttle.recorded[0]")]
     out.append(Param("FLTMODE_CH", wiring.rc_input("mode"), "wiring.rc_inputs.mode"))
     for name, pulse in (("stabilize", spec.mode_stabilize_us), ("alt_hold", spec.mode_alt_hold_us)):
-        out.append(Param(f"FLTMODE{mode_slot(pulse)}", MODE_NUMBERS[name], f"flight_modes.{name}_us"))
+        slot, mode = mode_slot(pulse), MODE_NUMBERS[name]
+        out.append(Param(f"FLTMODE{slot}", mode, f"flight_modes.{name}_us: {pulse} us is slot {slot}, {name} ({mode})"))
     return tuple(out)
