@@ -100,9 +100,15 @@ FW_HEXES := $(FW_ELVES:.elf=.hex)
 .PHONY: firmware firmware-uno firmware-host firmware-sim firmware-clean bench-firmware
 # $(APT_STAMP) (top-level Makefile) installs the toolchain on a fresh machine.
 firmware: $(APT_STAMP) $(FW_HEXES) firmware-host firmware-sim
-	@$(AVR_SIZE) -C --mcu=atmega328p $(FW_BUILD)/uno/uno.elf | grep -E 'Program|Data' | sed 's/^/uno:      /'
-	@$(AVR_SIZE) -C --mcu=atmega328p $(FW_BUILD)/uno_ppm/uno_ppm.elf | grep -E 'Program|Data' | sed 's/^/uno ppm:  /'
-	@$(AVR_SIZE) -C --mcu=atmega2560 $(FW_BUILD)/mega/mega.elf | grep -E 'Program|Data' | sed 's/^/mega:     /'
+	@$(call fw_report,uno,atmega328p)
+	@$(call fw_report,uno_ppm,atmega328p)
+	@$(call fw_report,mega,atmega2560)
+	@echo "Flash one: make upload PORT=/dev/ttyACM0 BOARD=uno|mega|uno_ppm"
+
+# $(call fw_report,NAME,MCU): the .hex to flash, its flash and RAM use.
+fw_report = $(AVR_SIZE) -C --mcu=$(2) $(FW_BUILD)/$(1)/$(1).elf | awk -v b=$(1) -v hex=$(FW_BUILD)/$(1)/$(1).hex \
+  '/^Program:/ {f = $$2; fp = $$4} /^Data:/ {d = $$2; dp = $$4} \
+   END {printf "%-8s %s  flash %d B %s full), RAM %d B %s full)\n", b, hex, f, fp, d, dp}'
 
 firmware-uno: $(FW_BUILD)/uno/uno.hex
 
@@ -144,3 +150,4 @@ firmware-clean:
 	rm -rf $(FW_BUILD)
 
 -include bench/firmware/bench.mk
+-include $(FW_DIR)/ide/ide.mk
