@@ -3,18 +3,18 @@
 #   make bench-protocol   Python codec vs f-string/slice floors, C++ StreamParser throughput and instructions per
 #                         frame, parser flash/RAM on the ATmega328P, generator run time; writes
 #                         bench/protocol/RESULTS.md
-#   make bench            every part's benchmark: bench-protocol, bench-firmware (firmware/firmware.mk) and
-#                         bench-pilot (pilot/pilot.mk)
+#   make bench            every part's benchmark: bench-protocol, bench-firmware (firmware/firmware.mk),
+#                         bench-pilot (pilot/pilot.mk) and bench-ide (bench/ide/bench.mk)
 #
 # BENCH_PROTOCOL_FLAGS=--quick for a smoke run (fewer repetitions; still writes RESULTS.md unless --no-write).
 
 BENCH_PROTOCOL_BUILD ?= build/bench/protocol
 BENCH_PROTOCOL_FLAGS ?=
 
-.PHONY: bench bench-protocol bench-firmware bench-pilot
+.PHONY: bench bench-protocol bench-firmware bench-pilot bench-ide
 
 # Run benchmarks one at a time (not with make -j): they time each other otherwise.
-bench: bench-protocol bench-firmware bench-pilot
+bench: bench-protocol bench-firmware bench-pilot bench-ide
 
 bench-protocol: deps
 	$(PY) bench/protocol/run.py --build $(BENCH_PROTOCOL_BUILD) $(BENCH_PROTOCOL_FLAGS)

@@ -67,6 +67,8 @@ endef
 
 $(eval $(call fw_core,uno,atmega328p,standard,AVR_UNO))
 $(eval $(call fw_core,mega,atmega2560,mega,AVR_MEGA2560))
+# Linker relaxation (call -> rcall where it reaches) on the Mega 2560, as the Arduino IDE links it.
+FW_CORE_mega_LDFLAGS := -Wl,--relax
 
 # $(call fw_board,NAME,CORE_KEY,EXTRA_DEFINES,SKETCH_SOURCES)
 # Builds $(FW_BUILD)/NAME/NAME.elf/.hex from a core and the sources.
@@ -81,7 +83,7 @@ $$(FW_$(1)_DIR)/$(1).elf: $(4) $$(FW_HEADERS) $$(FW_PROTO_SRC) $$(FW_PROTO_HDR) 
 	@mkdir -p $$(@D)
 	@test -f $$(DRONE_PROTOCOL_DIR)/src/DroneProtocol.h || { echo "missing $$(DRONE_PROTOCOL_DIR)/src/DroneProtocol.h: run the generator first" >&2; exit 1; }
 	@echo "  LD    $$@"
-	@$$(AVR_CXX) $$(FW_$(1)_FLAGS) $$(FW_AVR_CXXFLAGS) $$(FW_WARN) -fuse-linker-plugin -Wl,--gc-sections \
+	@$$(AVR_CXX) $$(FW_$(1)_FLAGS) $$(FW_AVR_CXXFLAGS) $$(FW_WARN) -fuse-linker-plugin -Wl,--gc-sections $$(FW_CORE_$(2)_LDFLAGS) \
 	  -I$$(DRONE_PROTOCOL_DIR)/src -I$$(FW_DIR)/drone \
 	  -x c++ -include Arduino.h $$(filter %.ino,$(4)) -x none $$(filter-out %.ino,$(4)) $$(FW_PROTO_SRC) \
 	  $$(FW_CORE_$(2)_DIR)/core.a -lm -o $$@

@@ -41,3 +41,5 @@ arduino-library: $(VENV_STAMP)
 arduino-install: $(VENV_STAMP)
 	@test -n "$(SKETCHBOOK)" || { echo "SKETCHBOOK is not set: make arduino-install SKETCHBOOK=~/Arduino" >&2; exit 2; }
 	@$(PY) firmware/ide/sketchbook.py install "$(SKETCHBOOK)"
+
+-include bench/ide/bench.mk
