@@ -7,7 +7,8 @@
 #                         distractor views, tuning and held-out photos, time vs the cvtColor+inRange floor;
 #                         writes bench/vision/RESULTS.md (BENCH_VISION_FLAGS=--quick for a smoke run)
 #   make bench            every part's benchmark: bench-protocol, bench-firmware (firmware/firmware.mk),
-#                         bench-pilot (pilot/pilot.mk) and bench-vision
+#                         bench-pilot (pilot/pilot.mk), bench-vision and bench-ide
+#                         (bench/ide/bench.mk)
 #
 # BENCH_PROTOCOL_FLAGS=--quick for a smoke run (fewer repetitions; still writes RESULTS.md unless --no-write).
 
@@ -16,10 +17,10 @@ BENCH_PROTOCOL_FLAGS ?=
 
 BENCH_VISION_FLAGS ?=
 
-.PHONY: bench bench-protocol bench-firmware bench-pilot bench-vision
+.PHONY: bench bench-protocol bench-firmware bench-pilot bench-vision bench-ide
 
 # Run benchmarks one at a time (not with make -j): they time each other otherwise.
-bench: bench-protocol bench-firmware bench-pilot bench-vision
+bench: bench-protocol bench-firmware bench-pilot bench-vision bench-ide
 
 bench-vision: deps
 	PYTHONPATH=bench/vision $(PY) bench/vision/run.py $(BENCH_VISION_FLAGS)

@@ -1,20 +1,58 @@
-"""The generated targets. Adding one means a template folder under templates/ and one line here."""
+"""The generated targets. Adding one means a template folder under templates/ and one line here.
+
+The do-not-edit header of each generated file is written in the comment syntax of that file's own format,
+decided per file (a target mixes formats: the Arduino library has C++ next to a properties file)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import PurePosixPath
 
 
 @dataclass(frozen=True)
 class Target:
     name: str  # the folder of templates under generator/templates/
     out_dir: str  # where its files go, relative to the output folder ("" for the top)
-    comment: str  # how its files carry the do-not-edit header: "#", "//", "<!--", or "json" (the template does)
 
 
 TARGETS: tuple[Target, ...] = (
-    Target("python", "python", "#"),
-    Target("arduino", "arduino", "//"),
-    Target("docs", "docs", "<!--"),
-    Target("vectors", "", "json"),
+    Target("python", "python"),
+    Target("arduino", "arduino"),
+    Target("docs", "docs"),
+    Target("vectors", ""),
+    Target("ardupilot", "ardupilot"),
 )
+
+# How a file carries the header: a line-comment prefix, "<!--" (one block comment), or "json" (no comments:
+# the template prints the header as its first member). By whole file name first, then by suffix.
+COMMENT_BY_NAME = {
+    "keywords.txt": "#",  # the Arduino IDE skips lines starting with '#'
+    "py.typed": "#",
+}
+COMMENT_BY_SUFFIX = {
+    ".properties": "#",  # Arduino's library.properties: '#' is the only comment its parsers accept
+    ".py": "#",
+    ".toml": "#",
+    ".parm": "#",  # ArduPilot parameter files (Mission Planner, QGroundControl, MAVProxy)
+    ".h": "//",
+    ".hpp": "//",
+    ".c": "//",
+    ".cpp": "//",
+    ".ino": "//",
+    ".ts": "//",
+    ".js": "//",
+    ".rs": "//",
+    ".md": "<!--",
+    ".html": "<!--",
+    ".json": "json",
+}
+
+
+def comment_style(path: str) -> str:
+    """The header style of the generated file at `path`; a format nobody taught us is an error, not a guess."""
+    p = PurePosixPath(path)
+    style = COMMENT_BY_NAME.get(p.name) or COMMENT_BY_SUFFIX.get(p.suffix)
+    if style is None:
+        raise ValueError(f"no comment syntax known for generated file '{path}': add its name or suffix to "
+                         "COMMENT_BY_NAME / COMMENT_BY_SUFFIX in generator/targets.py")
+    return style
