@@ -17,4 +17,5 @@ TARGETS: tuple[Target, ...] = (
     Target("arduino", "arduino", "//"),
     Target("docs", "docs", "<!--"),
     Target("vectors", "", "json"),
+    Target("rust", "rust", "json"),  # "json": each template prints the header in its file's own syntax
 )
