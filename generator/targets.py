@@ -17,5 +17,6 @@ TARGETS: tuple[Target, ...] = (
     Target("arduino", "arduino", "//"),
     Target("docs", "docs", "<!--"),
     Target("vectors", "", "json"),
-    Target("rust", "rust", "json"),  # "json": each template prints the header in its file's own syntax
+    Target("rust", "rust", "json"),
+    Target("c", "c", "//"),  # "json": each template prints the header in its file's own syntax
 )
