@@ -7,6 +7,7 @@ import textwrap
 from collections.abc import Callable
 from typing import Any
 
+from generator.model import check_text
 from generator.names import pascal
 
 
@@ -58,6 +59,11 @@ def rust_string(text: str) -> str:
     return cpp_string(text)
 
 
+def check_hex(text: str) -> str:
+    """The crc8 integrity check of ASCII text, as the two hex digits the wire carries."""
+    return check_text(text.encode("ascii"))
+
+
 def initials(name: str) -> str:
     """The C99 target's prefix of a snake_case name: drone_protocol -> dp."""
     return "".join(part[0] for part in name.split("_") if part)
@@ -92,6 +98,7 @@ ALL: dict[str, Callable[..., Any]] = {
     "rust_byte": rust_byte,
     "rust_string": rust_string,
     "initials": initials,
+    "check_hex": check_hex,
     "md_cell": md_cell,
     "md_code": md_code,
     "pascal": pascal,

@@ -15,10 +15,10 @@ mod reply;
 mod stream;
 
 pub use reply::{
-    parse_reply, write_accepted, write_failsafe, write_ready, write_rejected, Reply, ReplyError, ReplyKind,
-    REPLY_MAX_LENGTH,
+    parse_reply, write_accepted, write_failsafe, write_ready, write_rejected, Reply, ReplyError, ReplyKind, State,
+    Status, LASER_OFF, LASER_ON, REPLY_MAX_LENGTH, STATUS_SEPARATOR,
 };
-pub use stream::StreamParser;
+pub use stream::{StreamParser, STREAM_ERRORS};
 
 /// The spec's fingerprint: both ends of the link compare it (the Arduino prints it in its ready line).
 pub const SPEC_FINGERPRINT: &str = "50da548a0ba6e075";
@@ -29,8 +29,14 @@ pub const PROTOCOL_NAME: &str = "drone_protocol";
 /// The spec's version (the crate's major version).
 pub const PROTOCOL_VERSION: u16 = 1;
 
-/// Bytes of a frame.
+/// Bytes of a frame's command (category, direction, value digits).
 pub const FRAME_LENGTH: usize = 6;
+/// The integrity mode: "none", or "crc8" (two hex digits of [`crc8`] after the command's bytes).
+pub const INTEGRITY: &str = "none";
+/// Check characters after the command's bytes on the wire.
+pub const CHECK_LENGTH: usize = 0;
+/// Bytes of a frame on the wire.
+pub const WIRE_LENGTH: usize = FRAME_LENGTH + CHECK_LENGTH;
 /// Decimal digits of a frame's value.
 pub const VALUE_WIDTH: usize = 4;
 /// Serial line speed.
@@ -55,7 +61,23 @@ pub const MODE_ALT_HOLD_US: u16 = 1425;
 pub const SPEED_STEP_US: u16 = 100;
 
 /// One frame on the wire.
-pub type Frame = [u8; FRAME_LENGTH];
+pub type Frame = [u8; WIRE_LENGTH];
+
+/// CRC-8/SMBUS (polynomial 0x07, initial value 0, no reflection): the check of the crc8 integrity mode.
+pub const fn crc8(data: &[u8]) -> u8 {
+    let mut crc = 0u8;
+    let mut i = 0;
+    while i < data.len() {
+        crc ^= data[i];
+        let mut bit = 0;
+        while bit < 8 {
+            crc = if crc & 0x80 != 0 { (crc << 1) ^ 0x07 } else { crc << 1 };
+            bit += 1;
+        }
+        i += 1;
+    }
+    crc
+}
 
 /// An RC channel: recorded extremes and the derived speeds (µs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -511,7 +533,7 @@ impl Command {
 
     /// Its frame.
     pub fn encode(&self) -> Result<Frame, Error> {
-        let mut frame = [0; FRAME_LENGTH];
+        let mut frame = [0; WIRE_LENGTH];
         encode(self.id, self.value, &mut frame)?;
         Ok(frame)
     }
@@ -527,7 +549,7 @@ pub fn encode(id: CommandId, value: u16, out: &mut Frame) -> Result<(), Error> {
     out[0] = info.category as u8;
     out[1] = info.direction;
     let mut rest = value;
-    for byte in out[2..].iter_mut().rev() {
+    for byte in out[2..FRAME_LENGTH].iter_mut().rev() {
         *byte = b'0' + (rest % 10) as u8;
         rest /= 10;
     }
@@ -549,7 +571,7 @@ pub(crate) fn check_byte(frame: &Frame, pos: usize, id: &mut Option<CommandId>) 
                 None => Err(Error::BadDirection),
             }
         }
-        _ if frame[pos].is_ascii_digit() => Ok(()),
+        _ if pos < FRAME_LENGTH && frame[pos].is_ascii_digit() => Ok(()),
         _ => Err(Error::BadDigit),
     }
 }
@@ -558,7 +580,7 @@ pub(crate) fn check_byte(frame: &Frame, pos: usize, id: &mut Option<CommandId>) 
 #[inline]
 pub(crate) fn finish(frame: &Frame, id: CommandId) -> Result<Command, Error> {
     let mut value: u16 = 0;
-    for &digit in &frame[2..] {
+    for &digit in &frame[2..FRAME_LENGTH] {
         value = value * 10 + u16::from(digit - b'0');
     }
     let info = id.info();
@@ -572,11 +594,11 @@ pub(crate) fn finish(frame: &Frame, id: CommandId) -> Result<Command, Error> {
 pub fn decode(bytes: &[u8]) -> Result<Command, Error> {
     let frame: &Frame = match bytes.try_into() {
         Ok(frame) => frame,
-        Err(_) if bytes.len() < FRAME_LENGTH => return Err(Error::TooShort),
+        Err(_) if bytes.len() < WIRE_LENGTH => return Err(Error::TooShort),
         Err(_) => return Err(Error::TooLong),
     };
     let mut id = None;
-    for pos in 0..FRAME_LENGTH {
+    for pos in 0..WIRE_LENGTH {
         check_byte(frame, pos, &mut id)?;
     }
     match id {

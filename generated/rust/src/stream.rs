@@ -3,26 +3,28 @@
 // Edit the spec and run `python -m generator` instead.
 //! The byte-at-a-time stream parser, with the same rules as the Arduino's C++ `StreamParser`.
 
-use crate::{check_byte, finish, Category, Command, CommandId, Error, FRAME_LENGTH, INTER_BYTE_TIMEOUT_MS};
+use crate::{check_byte, finish, Category, Command, CommandId, Error, Frame, FRAME_LENGTH, INTER_BYTE_TIMEOUT_MS, WIRE_LENGTH};
 
-/// The error kinds a stream parser meets and counts: the first ones of [`Error`], in order.
-pub const STREAM_ERRORS: [Error; 5] = [Error::BadCategory, Error::BadDirection, Error::BadDigit, Error::OutOfRange, Error::Timeout];
-const _: () = assert!(STREAM_ERRORS[0] as usize == 1 && STREAM_ERRORS[STREAM_ERRORS.len() - 1] as usize == STREAM_ERRORS.len());
+/// While the buffer holds fewer bytes than this, a digit never completes a frame (the fast path).
+const DIGITS_END: usize = if WIRE_LENGTH > FRAME_LENGTH { FRAME_LENGTH } else { FRAME_LENGTH - 1 };
+
+/// The error kinds a stream parser meets and counts.
+pub const STREAM_ERRORS: [Error; 5] = [Error::BadCategory, Error::BadDirection, Error::BadDigit, Error::OutOfRange, Error::Timeout, ];
 
 /// Finds frames in a byte stream that may hold garbage, lost bytes and pauses.
 ///
 /// On an invalid byte it slides forward one byte at a time, so a valid frame that follows garbage is never
 /// lost; a partial frame older than [`INTER_BYTE_TIMEOUT_MS`] is dropped (counted as [`Error::Timeout`])
-/// before the new byte is considered. Each [`feed`](StreamParser::feed) costs at most `FRAME_LENGTH` slides
-/// of `FRAME_LENGTH` checks: it never stalls.
+/// before the new byte is considered. Each [`feed`](StreamParser::feed) costs at most `WIRE_LENGTH` slides
+/// of `WIRE_LENGTH` checks: it never stalls.
 #[derive(Clone, Debug)]
 pub struct StreamParser {
-    buffer: [u8; FRAME_LENGTH],
+    buffer: Frame,
     length: usize,
     id: Option<CommandId>, // the command of buffer[0..2], set while length >= 2
     last_ms: u32,
     last_error: Option<Error>,
-    counts: [u16; STREAM_ERRORS.len()],
+    counts: [u16; Error::ALL.len()], // by Error value - 1
 }
 
 impl Default for StreamParser {
@@ -35,12 +37,12 @@ impl StreamParser {
     /// An empty parser (a `const fn`: a `static` parser needs no start-up code).
     pub const fn new() -> Self {
         StreamParser {
-            buffer: [0; FRAME_LENGTH],
+            buffer: [0; WIRE_LENGTH],
             length: 0,
             id: None,
             last_ms: 0,
             last_error: None,
-            counts: [0; STREAM_ERRORS.len()],
+            counts: [0; Error::ALL.len()],
         }
     }
 
@@ -56,7 +58,7 @@ impl StreamParser {
         // The common cases, each a check of the new byte alone (the buffer holds a valid prefix):
         let length = self.length;
         if length >= 2 {
-            if length < FRAME_LENGTH - 1 && byte.is_ascii_digit() {
+            if length < DIGITS_END && byte.is_ascii_digit() {
                 self.buffer[length] = byte; // a middle digit
                 self.length = length + 1;
                 return None;
@@ -93,7 +95,7 @@ impl StreamParser {
                 }
             }
             let outcome = match (result, self.id) {
-                (Ok(()), Some(id)) if self.length == FRAME_LENGTH => finish(&self.buffer, id).map(Some),
+                (Ok(()), Some(id)) if self.length == WIRE_LENGTH => finish(&self.buffer, id).map(Some),
                 (Ok(()), _) => Ok(None),
                 (Err(error), _) => Err(error),
             };
@@ -118,7 +120,6 @@ impl StreamParser {
         if self.last_error.is_none() {
             self.last_error = Some(error);
         }
-        // Error values 1..=STREAM_ERRORS.len() are the stream's kinds, in order.
         let i = (error as usize).wrapping_sub(1);
         if i < self.counts.len() {
             self.counts[i] = self.counts[i].saturating_add(1);
