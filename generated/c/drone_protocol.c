@@ -73,7 +73,18 @@ dp_error dp_error_from_code(char code) {
   return DP_ERROR_NONE;
 }
 
-dp_error dp_encode(dp_command_id id, uint16_t value, uint8_t out[DP_FRAME_LENGTH]) {
+uint8_t dp_crc8(const uint8_t *data, size_t length) {
+  uint8_t crc = 0;
+  size_t i;
+  int bit;
+  for (i = 0; i < length; ++i) {
+    crc ^= data[i];
+    for (bit = 0; bit < 8; ++bit) crc = (uint8_t)((crc & 0x80u) ? ((unsigned)crc << 1) ^ 0x07u : (unsigned)crc << 1);
+  }
+  return crc;
+}
+
+dp_error dp_encode(dp_command_id id, uint16_t value, uint8_t out[DP_WIRE_LENGTH]) {
   const dp_command_info *info = dp_command_info_of(id);
   int i;
   if (info == NULL) return DP_ERROR_BAD_CATEGORY;
@@ -113,80 +124,80 @@ static dp_error finish(const uint8_t *frame, int8_t index, dp_command *out) {
 dp_error dp_decode(const uint8_t *frame, size_t length, dp_command *out) {
   int8_t index = -1;
   uint8_t pos;
-  if (length < DP_FRAME_LENGTH) return DP_ERROR_TOO_SHORT;
-  if (length > DP_FRAME_LENGTH) return DP_ERROR_TOO_LONG;
-  for (pos = 0; pos < DP_FRAME_LENGTH; ++pos) {
+  if (length < DP_WIRE_LENGTH) return DP_ERROR_TOO_SHORT;
+  if (length > DP_WIRE_LENGTH) return DP_ERROR_TOO_LONG;
+  for (pos = 0; pos < DP_WIRE_LENGTH; ++pos) {
     const dp_error error = check_byte(frame, pos, &index);
     if (error != DP_ERROR_NONE) return error;
   }
   return finish(frame, index, out);
 }
 
-dp_error dp_move_forward(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]) {
+dp_error dp_move_forward(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]) {
   return dp_encode(DP_CMD_MOVE_FORWARD, speed, out);
 }
 
-dp_error dp_move_backward(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]) {
+dp_error dp_move_backward(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]) {
   return dp_encode(DP_CMD_MOVE_BACKWARD, speed, out);
 }
 
-dp_error dp_move_left(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]) {
+dp_error dp_move_left(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]) {
   return dp_encode(DP_CMD_MOVE_LEFT, speed, out);
 }
 
-dp_error dp_move_right(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]) {
+dp_error dp_move_right(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]) {
   return dp_encode(DP_CMD_MOVE_RIGHT, speed, out);
 }
 
-dp_error dp_move_up(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]) {
+dp_error dp_move_up(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]) {
   return dp_encode(DP_CMD_MOVE_UP, speed, out);
 }
 
-dp_error dp_move_down(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]) {
+dp_error dp_move_down(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]) {
   return dp_encode(DP_CMD_MOVE_DOWN, speed, out);
 }
 
-dp_error dp_turn_left(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]) {
+dp_error dp_turn_left(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]) {
   return dp_encode(DP_CMD_TURN_LEFT, speed, out);
 }
 
-dp_error dp_turn_right(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]) {
+dp_error dp_turn_right(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]) {
   return dp_encode(DP_CMD_TURN_RIGHT, speed, out);
 }
 
-dp_error dp_servo_up(uint16_t degrees, uint8_t out[DP_FRAME_LENGTH]) {
+dp_error dp_servo_up(uint16_t degrees, uint8_t out[DP_WIRE_LENGTH]) {
   return dp_encode(DP_CMD_SERVO_UP, degrees, out);
 }
 
-dp_error dp_servo_down(uint16_t degrees, uint8_t out[DP_FRAME_LENGTH]) {
+dp_error dp_servo_down(uint16_t degrees, uint8_t out[DP_WIRE_LENGTH]) {
   return dp_encode(DP_CMD_SERVO_DOWN, degrees, out);
 }
 
-dp_error dp_servo_left(uint16_t degrees, uint8_t out[DP_FRAME_LENGTH]) {
+dp_error dp_servo_left(uint16_t degrees, uint8_t out[DP_WIRE_LENGTH]) {
   return dp_encode(DP_CMD_SERVO_LEFT, degrees, out);
 }
 
-dp_error dp_servo_right(uint16_t degrees, uint8_t out[DP_FRAME_LENGTH]) {
+dp_error dp_servo_right(uint16_t degrees, uint8_t out[DP_WIRE_LENGTH]) {
   return dp_encode(DP_CMD_SERVO_RIGHT, degrees, out);
 }
 
-void dp_servo_reset(uint8_t out[DP_FRAME_LENGTH]) { (void)dp_encode(DP_CMD_SERVO_RESET, 0, out); }
+void dp_servo_reset(uint8_t out[DP_WIRE_LENGTH]) { (void)dp_encode(DP_CMD_SERVO_RESET, 0, out); }
 
-void dp_laser_toggle(uint8_t out[DP_FRAME_LENGTH]) { (void)dp_encode(DP_CMD_LASER_TOGGLE, 0, out); }
+void dp_laser_toggle(uint8_t out[DP_WIRE_LENGTH]) { (void)dp_encode(DP_CMD_LASER_TOGGLE, 0, out); }
 
-void dp_laser_on(uint8_t out[DP_FRAME_LENGTH]) { (void)dp_encode(DP_CMD_LASER_ON, 0, out); }
+void dp_laser_on(uint8_t out[DP_WIRE_LENGTH]) { (void)dp_encode(DP_CMD_LASER_ON, 0, out); }
 
-void dp_laser_off(uint8_t out[DP_FRAME_LENGTH]) { (void)dp_encode(DP_CMD_LASER_OFF, 0, out); }
+void dp_laser_off(uint8_t out[DP_WIRE_LENGTH]) { (void)dp_encode(DP_CMD_LASER_OFF, 0, out); }
 
-void dp_arm(uint8_t out[DP_FRAME_LENGTH]) { (void)dp_encode(DP_CMD_ARM, 0, out); }
+void dp_arm(uint8_t out[DP_WIRE_LENGTH]) { (void)dp_encode(DP_CMD_ARM, 0, out); }
 
-void dp_disarm(uint8_t out[DP_FRAME_LENGTH]) { (void)dp_encode(DP_CMD_DISARM, 0, out); }
+void dp_disarm(uint8_t out[DP_WIRE_LENGTH]) { (void)dp_encode(DP_CMD_DISARM, 0, out); }
 
-void dp_hold_altitude(uint8_t out[DP_FRAME_LENGTH]) { (void)dp_encode(DP_CMD_HOLD_ALTITUDE, 0, out); }
+void dp_hold_altitude(uint8_t out[DP_WIRE_LENGTH]) { (void)dp_encode(DP_CMD_HOLD_ALTITUDE, 0, out); }
 
-void dp_first_test(uint8_t out[DP_FRAME_LENGTH]) { (void)dp_encode(DP_CMD_FIRST_TEST, 0, out); }
+void dp_first_test(uint8_t out[DP_WIRE_LENGTH]) { (void)dp_encode(DP_CMD_FIRST_TEST, 0, out); }
 
-void dp_land(uint8_t out[DP_FRAME_LENGTH]) { (void)dp_encode(DP_CMD_LAND, 0, out); }
+void dp_land(uint8_t out[DP_WIRE_LENGTH]) { (void)dp_encode(DP_CMD_LAND, 0, out); }
 
 void dp_stream_init(dp_stream_parser *parser) {
   const dp_stream_parser empty = DP_STREAM_PARSER_INIT;
@@ -212,11 +223,11 @@ bool dp_stream_append(dp_stream_parser *parser, uint8_t byte, dp_command *out) {
     for (pos = from; pos < parser->length && error == DP_ERROR_NONE; ++pos) {
       error = check_byte(parser->buffer, pos, &parser->index);
     }
-    if (error == DP_ERROR_NONE && parser->length == DP_FRAME_LENGTH) {
+    if (error == DP_ERROR_NONE && parser->length == DP_WIRE_LENGTH) {
       error = finish(parser->buffer, parser->index, out);
     }
     if (error == DP_ERROR_NONE) {
-      if (parser->length < DP_FRAME_LENGTH) return false;
+      if (parser->length < DP_WIRE_LENGTH) return false;
       parser->length = 0;
       return true;
     }
@@ -229,7 +240,7 @@ bool dp_stream_append(dp_stream_parser *parser, uint8_t byte, dp_command *out) {
 }
 
 uint16_t dp_stream_error_count(const dp_stream_parser *parser, dp_error error) {
-  return (error >= 1 && error <= DP_STREAM_ERROR_COUNT) ? parser->counts[error - 1] : 0;
+  return (error >= 1 && error <= DP_ERROR_COUNT) ? parser->counts[error - 1] : 0;
 }
 
 static const char *const REPLY_PREFIXES[] = {
@@ -243,6 +254,64 @@ const char *dp_reply_prefix(dp_reply_kind kind) {
   return (unsigned)kind < sizeof REPLY_PREFIXES / sizeof REPLY_PREFIXES[0] ? REPLY_PREFIXES[kind] : "";
 }
 
+const dp_state dp_states[DP_STATE_COUNT] = {
+DP_STATE_DISARMED, DP_STATE_ARMING, DP_STATE_ARMED, DP_STATE_HOLD_ALTITUDE, DP_STATE_MOVING, DP_STATE_LANDING, DP_STATE_DISARMING, DP_STATE_SELF_TEST, DP_STATE_FAILSAFE
+};
+
+bool dp_state_armed(dp_state state) {
+  switch (state) {
+    case DP_STATE_ARMED:
+    case DP_STATE_HOLD_ALTITUDE:
+    case DP_STATE_MOVING:
+    case DP_STATE_LANDING:
+    case DP_STATE_DISARMING:
+      return true;
+    default:
+      return false;
+  }
+}
+
+const char *dp_state_name(dp_state state) {
+  switch (state) {
+    case DP_STATE_DISARMED:
+      return "disarmed";
+    case DP_STATE_ARMING:
+      return "arming";
+    case DP_STATE_ARMED:
+      return "armed";
+    case DP_STATE_HOLD_ALTITUDE:
+      return "hold_altitude";
+    case DP_STATE_MOVING:
+      return "moving";
+    case DP_STATE_LANDING:
+      return "landing";
+    case DP_STATE_DISARMING:
+      return "disarming";
+    case DP_STATE_SELF_TEST:
+      return "self_test";
+    case DP_STATE_FAILSAFE:
+      return "failsafe";
+  }
+  return "unknown";
+}
+
+bool dp_is_state(uint8_t code) {
+  switch (code) {
+    case 'd':
+    case 'r':
+    case 'a':
+    case 'h':
+    case 'm':
+    case 'l':
+    case 'k':
+    case 't':
+    case 'f':
+      return true;
+    default:
+      return false;
+  }
+}
+
 static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
 
 /* The next whitespace-separated word of text[*at..length), or a zero length. */
@@ -252,6 +321,20 @@ static size_t word(const char *text, size_t length, size_t *at, const char **sta
   *start = text + *at;
   while (*at < length && !is_space(text[*at])) ++*at, ++n;
   return n;
+}
+
+/* Reads the separator and status that end text[0..*length) and drops them from *length. */
+static bool take_status(const char *text, size_t *length, dp_status *status) {
+  const size_t separator = sizeof DP_STATUS_SEPARATOR - 1;
+  const char *tail;
+  if (*length < separator + 2) return false;
+  tail = text + *length - separator - 2;
+  if (memcmp(tail, DP_STATUS_SEPARATOR, separator) != 0 || !dp_is_state((uint8_t)tail[separator])) return false;
+  if (tail[separator + 1] != DP_LASER_ON && tail[separator + 1] != DP_LASER_OFF) return false;
+  status->state = (dp_state)tail[separator];
+  status->laser_on = tail[separator + 1] == DP_LASER_ON;
+  *length -= separator + 2;
+  return true;
 }
 
 dp_reply_status dp_parse_reply(const char *line, size_t length, dp_reply *reply) {
@@ -274,12 +357,15 @@ dp_reply_status dp_parse_reply(const char *line, size_t length, dp_reply *reply)
   reply->kind = (dp_reply_kind)best;
   rest = line + prefix;
   length -= prefix;
+  if (reply->kind == DP_REPLY_READY) {
+    reply->protocol_length = word(rest, length, &at, &reply->protocol);
+    reply->fingerprint_length = word(rest, length, &at, &reply->fingerprint);
+    reply->integrity_length = word(rest, length, &at, &reply->integrity);
+    if (reply->integrity_length == 0 || word(rest, length, &at, &extra) != 0) return DP_REPLY_MALFORMED;
+    return DP_REPLY_OK;
+  }
+  if (!take_status(rest, &length, &reply->status)) return DP_REPLY_MALFORMED;
   switch (reply->kind) {
-    case DP_REPLY_READY:
-      reply->protocol_length = word(rest, length, &at, &reply->protocol);
-      reply->fingerprint_length = word(rest, length, &at, &reply->fingerprint);
-      if (reply->fingerprint_length == 0 || word(rest, length, &at, &extra) != 0) return DP_REPLY_MALFORMED;
-      return DP_REPLY_OK;
     case DP_REPLY_ACCEPTED: {
       const int index = length == 2 ? dp_find_command((uint8_t)rest[0], (uint8_t)rest[1]) : -1;
       if (index < 0) return DP_REPLY_MALFORMED;
@@ -289,10 +375,9 @@ dp_reply_status dp_parse_reply(const char *line, size_t length, dp_reply *reply)
     case DP_REPLY_REJECTED:
       reply->error = length == 1 ? dp_error_from_code(rest[0]) : DP_ERROR_NONE;
       return reply->error != DP_ERROR_NONE ? DP_REPLY_OK : DP_REPLY_MALFORMED;
-    case DP_REPLY_FAILSAFE:
+    default:
       return length == 0 ? DP_REPLY_OK : DP_REPLY_MALFORMED;
   }
-  return DP_REPLY_MALFORMED;
 }
 
 static size_t put(char *out, size_t n, const char *text) {
@@ -300,29 +385,37 @@ static size_t put(char *out, size_t n, const char *text) {
   return n;
 }
 
-size_t dp_write_ready(char out[DP_REPLY_MAX_LENGTH]) {
-  size_t n = put(out, 0, REPLY_PREFIXES[DP_REPLY_READY]);
-  n = put(out, n, " " DP_PROTOCOL_NAME " " DP_SPEC_FINGERPRINT "\n");
+static size_t put_status(char *out, size_t n, dp_status status) {
+  n = put(out, n, DP_STATUS_SEPARATOR);
+  out[n++] = (char)status.state;
+  out[n++] = status.laser_on ? DP_LASER_ON : DP_LASER_OFF;
   return n;
 }
 
-size_t dp_write_accepted(const dp_command *command, char out[DP_REPLY_MAX_LENGTH]) {
+/* Ends a line: the newline. */
+static size_t end_line(char *out, size_t n) {
+  out[n++] = '\n';
+  return n;
+}
+
+size_t dp_write_ready(char out[DP_REPLY_MAX_LENGTH]) {
+  const size_t n = put(out, 0, REPLY_PREFIXES[DP_REPLY_READY]);
+  return end_line(out, put(out, n, " " DP_PROTOCOL_NAME " " DP_SPEC_FINGERPRINT " " DP_INTEGRITY));
+}
+
+size_t dp_write_accepted(const dp_command *command, dp_status status, char out[DP_REPLY_MAX_LENGTH]) {
   size_t n = put(out, 0, REPLY_PREFIXES[DP_REPLY_ACCEPTED]);
   out[n++] = (char)command->category;
   out[n++] = (char)command->direction;
-  out[n++] = '\n';
-  return n;
+  return end_line(out, put_status(out, n, status));
 }
 
-size_t dp_write_rejected(dp_error error, char out[DP_REPLY_MAX_LENGTH]) {
+size_t dp_write_rejected(dp_error error, dp_status status, char out[DP_REPLY_MAX_LENGTH]) {
   size_t n = put(out, 0, REPLY_PREFIXES[DP_REPLY_REJECTED]);
   out[n++] = dp_error_code(error);
-  out[n++] = '\n';
-  return n;
+  return end_line(out, put_status(out, n, status));
 }
 
-size_t dp_write_failsafe(char out[DP_REPLY_MAX_LENGTH]) {
-  size_t n = put(out, 0, REPLY_PREFIXES[DP_REPLY_FAILSAFE]);
-  out[n++] = '\n';
-  return n;
+size_t dp_write_failsafe(dp_status status, char out[DP_REPLY_MAX_LENGTH]) {
+  return end_line(out, put_status(out, put(out, 0, REPLY_PREFIXES[DP_REPLY_FAILSAFE]), status));
 }

@@ -25,7 +25,13 @@ extern "C" {
 #define DP_PROTOCOL_NAME "drone_protocol"
 #define DP_PROTOCOL_VERSION 1
 
+/* Bytes of a frame's command (category, direction, value digits). */
 #define DP_FRAME_LENGTH 6
+/* The integrity mode: "none", or "crc8" (two hex digits of dp_crc8() after the command's bytes). */
+#define DP_INTEGRITY "none"
+#define DP_CHECK_LENGTH 0
+/* Bytes of a frame on the wire. */
+#define DP_WIRE_LENGTH 6
 #define DP_VALUE_WIDTH 4
 #define DP_BAUD 115200UL
 /* A partial frame older than this is dropped. */
@@ -298,44 +304,47 @@ static inline int dp_find_command(uint8_t category, uint8_t direction) {
   }
 }
 
-/* Write the frame of `id` with `value` into `out`; refuses values outside the command's range. */
-dp_error dp_encode(dp_command_id id, uint16_t value, uint8_t out[DP_FRAME_LENGTH]);
-/* Decode `length` bytes as one frame; on error `out` is unchanged. */
+/* CRC-8/SMBUS (polynomial 0x07, initial value 0, no reflection): the check of the crc8 integrity mode. */
+uint8_t dp_crc8(const uint8_t *data, size_t length);
+
+/* Write the frame of `id` with `value` into `out` (DP_WIRE_LENGTH bytes); refuses values outside the range. */
+dp_error dp_encode(dp_command_id id, uint16_t value, uint8_t out[DP_WIRE_LENGTH]);
+/* Decode `length` bytes as one frame on the wire; on error `out` is unchanged. */
 dp_error dp_decode(const uint8_t *frame, size_t length, dp_command *out);
 
 /* One function per command: write its frame into `out`. */
-dp_error dp_move_forward(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]); /* 1000..2000 us, default 1600 */
-dp_error dp_move_backward(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]); /* 1000..2000 us, default 1400 */
-dp_error dp_move_left(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]); /* 1000..2000 us, default 1400 */
-dp_error dp_move_right(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]); /* 1000..2000 us, default 1600 */
-dp_error dp_move_up(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]); /* 1029..2012 us, default 1621 */
-dp_error dp_move_down(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]); /* 1029..2012 us, default 1421 */
-dp_error dp_turn_left(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]); /* 1035..2012 us, default 1424 */
-dp_error dp_turn_right(uint16_t speed, uint8_t out[DP_FRAME_LENGTH]); /* 1035..2012 us, default 1624 */
-dp_error dp_servo_up(uint16_t degrees, uint8_t out[DP_FRAME_LENGTH]); /* 1..180 deg */
-dp_error dp_servo_down(uint16_t degrees, uint8_t out[DP_FRAME_LENGTH]); /* 1..180 deg */
-dp_error dp_servo_left(uint16_t degrees, uint8_t out[DP_FRAME_LENGTH]); /* 1..180 deg */
-dp_error dp_servo_right(uint16_t degrees, uint8_t out[DP_FRAME_LENGTH]); /* 1..180 deg */
-void dp_servo_reset(uint8_t out[DP_FRAME_LENGTH]); /* sx0000 */
-void dp_laser_toggle(uint8_t out[DP_FRAME_LENGTH]); /* l00000 */
-void dp_laser_on(uint8_t out[DP_FRAME_LENGTH]); /* ln0000 */
-void dp_laser_off(uint8_t out[DP_FRAME_LENGTH]); /* lf0000 */
-void dp_arm(uint8_t out[DP_FRAME_LENGTH]); /* ia0000 */
-void dp_disarm(uint8_t out[DP_FRAME_LENGTH]); /* ik0000 */
-void dp_hold_altitude(uint8_t out[DP_FRAME_LENGTH]); /* is0000 */
-void dp_first_test(uint8_t out[DP_FRAME_LENGTH]); /* it0000 */
-void dp_land(uint8_t out[DP_FRAME_LENGTH]); /* il0000 */
+dp_error dp_move_forward(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]); /* 1000..2000 us, default 1600 */
+dp_error dp_move_backward(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]); /* 1000..2000 us, default 1400 */
+dp_error dp_move_left(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]); /* 1000..2000 us, default 1400 */
+dp_error dp_move_right(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]); /* 1000..2000 us, default 1600 */
+dp_error dp_move_up(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]); /* 1029..2012 us, default 1621 */
+dp_error dp_move_down(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]); /* 1029..2012 us, default 1421 */
+dp_error dp_turn_left(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]); /* 1035..2012 us, default 1424 */
+dp_error dp_turn_right(uint16_t speed, uint8_t out[DP_WIRE_LENGTH]); /* 1035..2012 us, default 1624 */
+dp_error dp_servo_up(uint16_t degrees, uint8_t out[DP_WIRE_LENGTH]); /* 1..180 deg */
+dp_error dp_servo_down(uint16_t degrees, uint8_t out[DP_WIRE_LENGTH]); /* 1..180 deg */
+dp_error dp_servo_left(uint16_t degrees, uint8_t out[DP_WIRE_LENGTH]); /* 1..180 deg */
+dp_error dp_servo_right(uint16_t degrees, uint8_t out[DP_WIRE_LENGTH]); /* 1..180 deg */
+void dp_servo_reset(uint8_t out[DP_WIRE_LENGTH]); /* sx0000 */
+void dp_laser_toggle(uint8_t out[DP_WIRE_LENGTH]); /* l00000 */
+void dp_laser_on(uint8_t out[DP_WIRE_LENGTH]); /* ln0000 */
+void dp_laser_off(uint8_t out[DP_WIRE_LENGTH]); /* lf0000 */
+void dp_arm(uint8_t out[DP_WIRE_LENGTH]); /* ia0000 */
+void dp_disarm(uint8_t out[DP_WIRE_LENGTH]); /* ik0000 */
+void dp_hold_altitude(uint8_t out[DP_WIRE_LENGTH]); /* is0000 */
+void dp_first_test(uint8_t out[DP_WIRE_LENGTH]); /* it0000 */
+void dp_land(uint8_t out[DP_WIRE_LENGTH]); /* il0000 */
 
 /* Finds frames in a byte stream; the same rules as the Arduino's C++ StreamParser. On an invalid byte it slides
    forward one byte at a time, so a valid frame that follows garbage is never lost; a partial frame older than
    DP_INTER_BYTE_TIMEOUT_MS is dropped (counted as a timeout) before the new byte is considered. */
 typedef struct dp_stream_parser {
-  uint8_t buffer[DP_FRAME_LENGTH];
+  uint8_t buffer[DP_WIRE_LENGTH];
   uint8_t length;
   int8_t index; /* the command of buffer[0..1], valid while length >= 2 */
   dp_error last_error; /* the first error of the last feed */
   uint32_t last_ms;
-  uint16_t counts[DP_STREAM_ERROR_COUNT];
+  uint16_t counts[DP_ERROR_COUNT]; /* by error value - 1 */
 } dp_stream_parser;
 
 #define DP_STREAM_PARSER_INIT {{0}, 0, -1, DP_ERROR_NONE, 0, {0}}
@@ -378,8 +387,40 @@ uint16_t dp_stream_error_count(const dp_stream_parser *parser, dp_error error);
 /* Bytes of a frame started but not complete. */
 static inline uint8_t dp_stream_pending(const dp_stream_parser *parser) { return parser->length; }
 
-/* Replies (Arduino -> Pi): one ASCII line each, ending in '\n'. */
-#define DP_REPLY_MAX_LENGTH 39
+/* Replies (Arduino -> Pi): one ASCII line each, ending in '\n'. Accepted, rejected and failsafe lines end with the
+   drone's status. */
+#define DP_REPLY_MAX_LENGTH 44
+#define DP_STATUS_SEPARATOR " "
+#define DP_LASER_OFF '0'
+#define DP_LASER_ON '1'
+
+/* The drone's state, as every reply reports it. */
+typedef enum dp_state {
+  DP_STATE_DISARMED = 'd', /* Disarmed; movements are refused */
+  DP_STATE_ARMING = 'r', /* The arming sequence runs (throttle minimum, yaw right) */
+  DP_STATE_ARMED = 'a', /* armed: Armed, on the ground (throttle minimum) */
+  DP_STATE_HOLD_ALTITUDE = 'h', /* armed: Holding altitude, sticks neutral */
+  DP_STATE_MOVING = 'm', /* armed: A movement or turn runs until safety.command_timeout_ms */
+  DP_STATE_LANDING = 'l', /* armed: The landing routine descends, then disarms */
+  DP_STATE_DISARMING = 'k', /* armed: The disarm sequence runs (throttle minimum, yaw left) */
+  DP_STATE_SELF_TEST = 't', /* The self-test runs (servo sweep, laser blinks) */
+  DP_STATE_FAILSAFE = 'f', /* No valid frame for safety.failsafe_timeout_ms: failsafe throttle, laser off; the flight controller lands and disarms itself, and the firmware needs a new arming sequence */
+} dp_state;
+#define DP_STATE_COUNT 9
+/* Every state, in spec order. */
+extern const dp_state dp_states[DP_STATE_COUNT];
+
+typedef struct dp_status {
+  dp_state state;
+  bool laser_on;
+} dp_status;
+
+/* May the motors spin in this state? */
+bool dp_state_armed(dp_state state);
+/* The state's name in the spec, or "unknown". */
+const char *dp_state_name(dp_state state);
+/* Is this byte a state's code? */
+bool dp_is_state(uint8_t code);
 
 typedef enum dp_reply_kind {
   DP_REPLY_READY, /* "#READY": Printed once at boot, with the protocol name, the spec fingerprint and the integrity mode. */
@@ -392,16 +433,20 @@ typedef struct dp_reply {
   dp_reply_kind kind;
   dp_command_id command; /* accepted */
   dp_error error;        /* rejected */
+  dp_status status;      /* accepted, rejected, failsafe */
   const char *protocol;      /* ready: the protocol name, not NUL-terminated */
   size_t protocol_length;
   const char *fingerprint;   /* ready: the firmware's spec fingerprint, not NUL-terminated */
   size_t fingerprint_length;
+  const char *integrity;     /* ready: the firmware's integrity mode, not NUL-terminated */
+  size_t integrity_length;
 } dp_reply;
 
 typedef enum dp_reply_status {
   DP_REPLY_OK = 0,
   DP_REPLY_UNKNOWN,  /* the line starts with no reply's prefix */
-  DP_REPLY_MALFORMED /* it starts like reply->kind, but the rest is wrong */
+  DP_REPLY_MALFORMED, /* it starts like reply->kind, but the rest is wrong */
+  DP_REPLY_BAD_CHECK   /* its integrity check is missing or does not match its bytes */
 } dp_reply_status;
 
 /* Parse one reply line of `length` bytes (with or without its "\n" / "\r\n"). */
@@ -411,9 +456,9 @@ const char *dp_reply_prefix(dp_reply_kind kind);
 
 /* Each writes one reply line ending in '\n' into `out` (no NUL) and returns its length. */
 size_t dp_write_ready(char out[DP_REPLY_MAX_LENGTH]);
-size_t dp_write_accepted(const dp_command *command, char out[DP_REPLY_MAX_LENGTH]);
-size_t dp_write_rejected(dp_error error, char out[DP_REPLY_MAX_LENGTH]);
-size_t dp_write_failsafe(char out[DP_REPLY_MAX_LENGTH]);
+size_t dp_write_accepted(const dp_command *command, dp_status status, char out[DP_REPLY_MAX_LENGTH]);
+size_t dp_write_rejected(dp_error error, dp_status status, char out[DP_REPLY_MAX_LENGTH]);
+size_t dp_write_failsafe(dp_status status, char out[DP_REPLY_MAX_LENGTH]);
 
 #ifdef __cplusplus
 }

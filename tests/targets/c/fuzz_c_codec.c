@@ -23,10 +23,10 @@
 
 static void check_command(const dp_command *cmd, const uint8_t *bytes) {
   const dp_command_info *info = dp_command_info_of(cmd->id);
-  uint8_t again[DP_FRAME_LENGTH];
+  uint8_t again[DP_WIRE_LENGTH];
   CHECK(info != NULL && info->category == cmd->category && info->direction == cmd->direction);
   CHECK(cmd->value >= info->min && cmd->value <= info->max);
-  CHECK(dp_encode(cmd->id, cmd->value, again) == DP_ERROR_NONE && memcmp(again, bytes, DP_FRAME_LENGTH) == 0);
+  CHECK(dp_encode(cmd->id, cmd->value, again) == DP_ERROR_NONE && memcmp(again, bytes, DP_WIRE_LENGTH) == 0);
 }
 
 static void fuzz_stream(const uint8_t *data, size_t size) {
@@ -49,7 +49,7 @@ static void fuzz_stream(const uint8_t *data, size_t size) {
     }
     got = dp_stream_feed(&parser, byte, now, &cmd);
     CHECK(got == reference_feed(&ref, byte, now));
-    CHECK(dp_stream_pending(&parser) == ref.length && ref.length < DP_FRAME_LENGTH);
+    CHECK(dp_stream_pending(&parser) == ref.length && ref.length < DP_WIRE_LENGTH);
     if (got) check_command(&cmd, ref.frame);
     for (e = 1; e <= DP_ERROR_COUNT; ++e) {
       const uint32_t want = ref.counts[e] > UINT16_MAX ? UINT16_MAX : ref.counts[e];
@@ -62,18 +62,18 @@ static void fuzz_decode(const uint8_t *data, size_t size) {
   dp_command cmd;
   size_t at;
   const dp_error whole = dp_decode(data, size, &cmd);
-  if (size < DP_FRAME_LENGTH) CHECK(whole == DP_ERROR_TOO_SHORT);
-  if (size > DP_FRAME_LENGTH) CHECK(whole == DP_ERROR_TOO_LONG);
-  for (at = 0; at + DP_FRAME_LENGTH <= size && at < 64; ++at) {
-    const dp_error error = dp_decode(data + at, DP_FRAME_LENGTH, &cmd);
-    CHECK(error == reference_first_error(data + at, DP_FRAME_LENGTH));
+  if (size < DP_WIRE_LENGTH) CHECK(whole == DP_ERROR_TOO_SHORT);
+  if (size > DP_WIRE_LENGTH) CHECK(whole == DP_ERROR_TOO_LONG);
+  for (at = 0; at + DP_WIRE_LENGTH <= size && at < 64; ++at) {
+    const dp_error error = dp_decode(data + at, DP_WIRE_LENGTH, &cmd);
+    CHECK(error == reference_first_error(data + at, DP_WIRE_LENGTH));
     if (error == DP_ERROR_NONE) check_command(&cmd, data + at);
   }
 }
 
 static void fuzz_encode(const uint8_t *data, size_t size) {
   size_t at;
-  uint8_t frame[DP_FRAME_LENGTH];
+  uint8_t frame[DP_WIRE_LENGTH];
   for (at = 0; at + 3 <= size && at < 48; at += 3) {
     const dp_command_id id = (dp_command_id)(data[at] % DP_COMMAND_COUNT);
     const uint16_t value = (uint16_t)(data[at + 1] << 8 | data[at + 2]);
@@ -82,7 +82,7 @@ static void fuzz_encode(const uint8_t *data, size_t size) {
     dp_command cmd;
     CHECK((error == DP_ERROR_NONE) == (value >= info->min && value <= info->max));
     if (error != DP_ERROR_NONE) continue;
-    CHECK(dp_decode(frame, DP_FRAME_LENGTH, &cmd) == DP_ERROR_NONE && cmd.id == id && cmd.value == value);
+    CHECK(dp_decode(frame, DP_WIRE_LENGTH, &cmd) == DP_ERROR_NONE && cmd.id == id && cmd.value == value);
   }
   CHECK(dp_encode((dp_command_id)DP_COMMAND_COUNT, 0, frame) != DP_ERROR_NONE);
 }
@@ -94,7 +94,12 @@ static void fuzz_names_and_replies(const uint8_t *data, size_t size) {
   if (size == 0) return;
   CHECK(dp_error_name((dp_error)data[0]) != NULL && dp_command_name((dp_command_id)data[0]) != NULL);
   CHECK(dp_error_code((dp_error)data[0]) > 0x20);
-  n = dp_write_rejected((dp_error)(data[0] % (DP_ERROR_COUNT + 1)), line);
+  {
+    dp_status status;
+    status.state = dp_states[data[0] % DP_STATE_COUNT];
+    status.laser_on = (data[0] & 1) != 0;
+    n = dp_write_rejected((dp_error)(data[0] % (DP_ERROR_COUNT + 1)), status, line);
+  }
   CHECK(n >= 2 && n <= DP_REPLY_MAX_LENGTH && line[n - 1] == '\n');
   if (dp_parse_reply((const char *)data, size, &reply) == DP_REPLY_OK && reply.kind == DP_REPLY_READY) {
     CHECK(reply.protocol >= (const char *)data && reply.fingerprint + reply.fingerprint_length <= (const char *)data + size);

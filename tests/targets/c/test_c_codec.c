@@ -37,7 +37,7 @@ static bool field(const char *line, const char *key, char *out, size_t size) {
   return true;
 }
 
-static uint8_t valid[512][DP_FRAME_LENGTH];
+static uint8_t valid[512][DP_WIRE_LENGTH];
 static size_t valid_count = 0;
 
 static void check_vector(const char *line) {
@@ -52,16 +52,26 @@ static void check_vector(const char *line) {
     sscanf(hex + i, "%2x", &byte);
     frame[n++] = (uint8_t)byte;
   }
+#if DP_CHECK_LENGTH > 0
+  /* On the wire a frame carries its check; vectors of other lengths are about the command's bytes alone. */
+  if (n != DP_FRAME_LENGTH) return;
+  reference_check(frame, n, frame + n);
+  n += DP_CHECK_LENGTH;
+#endif
   result = dp_decode(frame, n, &cmd);
   if (strcmp(ok, "true") == 0) {
-    uint8_t again[DP_FRAME_LENGTH];
+    uint8_t again[DP_WIRE_LENGTH];
     field(line, "command", command, sizeof command);
     field(line, "value", value, sizeof value);
     CHECK(result == DP_ERROR_NONE, "%s rejected: %s", hex, dp_error_name(result));
     if (result != DP_ERROR_NONE) return;
     CHECK(strcmp(dp_command_name(cmd.id), command) == 0 && cmd.value == atoi(value), "%s", hex);
     CHECK(dp_encode(cmd.id, cmd.value, again) == DP_ERROR_NONE && memcmp(again, frame, n) == 0, "%s", hex);
-    if (valid_count < sizeof valid / sizeof valid[0]) memcpy(valid[valid_count++], frame, DP_FRAME_LENGTH);
+    if (valid_count < sizeof valid / sizeof valid[0]) memcpy(valid[valid_count++], frame, DP_WIRE_LENGTH);
+#if DP_CHECK_LENGTH > 0
+    frame[DP_WIRE_LENGTH - 1] = frame[DP_WIRE_LENGTH - 1] == '0' ? '1' : '0';
+    CHECK(dp_decode(frame, n, &cmd) == DP_ERROR_BAD_CHECK, "%s with a wrong check", hex);
+#endif
   } else {
     field(line, "error", error, sizeof error);
     CHECK(strcmp(dp_error_name(result), error) == 0, "%s: got %s, want %s", hex, dp_error_name(result), error);
@@ -72,30 +82,47 @@ static void check_replies(void) {
   char line[DP_REPLY_MAX_LENGTH];
   dp_reply reply;
   size_t n = dp_write_ready(line);
-  int i;
+  int i, s;
   CHECK(dp_parse_reply(line, n, &reply) == DP_REPLY_OK && reply.kind == DP_REPLY_READY, "ready");
   CHECK(reply.fingerprint_length == strlen(DP_SPEC_FINGERPRINT) &&
             memcmp(reply.fingerprint, DP_SPEC_FINGERPRINT, reply.fingerprint_length) == 0, "fingerprint");
-  for (i = 0; i < DP_COMMAND_COUNT; ++i) {
-    const dp_command_info *info = dp_command_info_of((dp_command_id)i);
-    dp_command cmd;
-    cmd.id = (dp_command_id)i;
-    cmd.category = info->category;
-    cmd.direction = info->direction;
-    cmd.value = info->min;
-    n = dp_write_accepted(&cmd, line);
-    CHECK(line[n - 1] == '\n' && dp_parse_reply(line, n, &reply) == DP_REPLY_OK && reply.command == cmd.id, "%d", i);
+  CHECK(reply.integrity_length == strlen(DP_INTEGRITY) && memcmp(reply.integrity, DP_INTEGRITY, reply.integrity_length) == 0,
+        "integrity");
+  for (s = 0; s < DP_STATE_COUNT; ++s) {
+    dp_status status;
+    status.state = dp_states[s];
+    status.laser_on = s % 2 == 1;
+    CHECK(dp_is_state((uint8_t)dp_states[s]) && strcmp(dp_state_name(dp_states[s]), "unknown") != 0, "state %d", s);
+    for (i = 0; i < DP_COMMAND_COUNT; ++i) {
+      const dp_command_info *info = dp_command_info_of((dp_command_id)i);
+      dp_command cmd;
+      cmd.id = (dp_command_id)i;
+      cmd.category = info->category;
+      cmd.direction = info->direction;
+      cmd.value = info->min;
+      n = dp_write_accepted(&cmd, status, line);
+      CHECK(line[n - 1] == '\n' && n <= DP_REPLY_MAX_LENGTH, "%d", i);
+      CHECK(dp_parse_reply(line, n, &reply) == DP_REPLY_OK && reply.kind == DP_REPLY_ACCEPTED && reply.command == cmd.id &&
+                reply.status.state == status.state && reply.status.laser_on == status.laser_on, "%d", i);
+    }
+    for (i = 1; i <= DP_ERROR_COUNT; ++i) {
+      n = dp_write_rejected((dp_error)i, status, line);
+      CHECK(dp_parse_reply(line, n, &reply) == DP_REPLY_OK && reply.error == (dp_error)i && reply.status.state == status.state,
+            "%d", i);
+      CHECK(dp_error_from_code(dp_error_code((dp_error)i)) == (dp_error)i, "%d", i);
+    }
+    n = dp_write_failsafe(status, line);
+    CHECK(dp_parse_reply(line, n, &reply) == DP_REPLY_OK && reply.kind == DP_REPLY_FAILSAFE &&
+              reply.status.laser_on == status.laser_on, "failsafe");
   }
-  for (i = 1; i <= DP_ERROR_COUNT; ++i) {
-    n = dp_write_rejected((dp_error)i, line);
-    CHECK(dp_parse_reply(line, n, &reply) == DP_REPLY_OK && reply.error == (dp_error)i, "%d", i);
-    CHECK(dp_error_from_code(dp_error_code((dp_error)i)) == (dp_error)i, "%d", i);
-  }
-  n = dp_write_failsafe(line);
-  CHECK(dp_parse_reply(line, n, &reply) == DP_REPLY_OK && reply.kind == DP_REPLY_FAILSAFE, "failsafe");
+#if DP_CHECK_LENGTH > 0
+  line[n - 2] = line[n - 2] == '0' ? '1' : '0';
+  CHECK(dp_parse_reply(line, n, &reply) == DP_REPLY_BAD_CHECK, "a reply with a wrong check");
+#else
   CHECK(dp_parse_reply("?", 1, &reply) == DP_REPLY_UNKNOWN, "unknown line");
   CHECK(dp_parse_reply(dp_reply_prefix(DP_REPLY_FAILSAFE), strlen(dp_reply_prefix(DP_REPLY_FAILSAFE)), &reply) ==
-            DP_REPLY_OK, "prefix alone");
+            DP_REPLY_MALFORMED, "a failsafe line without its status");
+#endif
 }
 
 static uint64_t rng_state = 0x20261123u;
@@ -114,18 +141,18 @@ static void check_stream(void) {
   int e;
   memset(&ref, 0, sizeof ref);
   while (fed < 200000) {
-    uint8_t chunk[8];
+    uint8_t chunk[DP_WIRE_LENGTH + 2];
     uint32_t len, i;
     const uint32_t style = next(4);
     if (style <= 1) {
-      memcpy(chunk, valid[next((uint32_t)valid_count)], DP_FRAME_LENGTH);
-      len = DP_FRAME_LENGTH;
+      memcpy(chunk, valid[next((uint32_t)valid_count)], DP_WIRE_LENGTH);
+      len = DP_WIRE_LENGTH;
     } else if (style == 2) {
       len = next(8);
       for (i = 0; i < len; ++i) chunk[i] = (uint8_t)next(256);
     } else {
-      memcpy(chunk, valid[next((uint32_t)valid_count)], DP_FRAME_LENGTH);
-      len = next(DP_FRAME_LENGTH);
+      memcpy(chunk, valid[next((uint32_t)valid_count)], DP_WIRE_LENGTH);
+      len = next(DP_WIRE_LENGTH);
     }
     for (i = 0; i < len; ++i, ++fed) {
       dp_command cmd;
@@ -136,8 +163,8 @@ static void check_stream(void) {
       CHECK(got == want, "byte %zu", fed);
       CHECK(dp_stream_pending(&parser) == ref.length, "byte %zu", fed);
       if (got && want) {
-        uint8_t again[DP_FRAME_LENGTH];
-        CHECK(dp_encode(cmd.id, cmd.value, again) == DP_ERROR_NONE && memcmp(again, ref.frame, DP_FRAME_LENGTH) == 0,
+        uint8_t again[DP_WIRE_LENGTH];
+        CHECK(dp_encode(cmd.id, cmd.value, again) == DP_ERROR_NONE && memcmp(again, ref.frame, DP_WIRE_LENGTH) == 0,
               "byte %zu", fed);
         ++frames;
       }
