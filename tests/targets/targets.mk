@@ -71,3 +71,9 @@ c-fuzz-smoke: $(TARGETS_BUILD)/fuzz_c_codec $(TARGETS_BUILD)/c.dict
 
 c-fuzz: $(TARGETS_BUILD)/fuzz_c_codec $(TARGETS_BUILD)/c.dict
 	$(C_FUZZ_RUN) -max_total_time=$(C_FUZZ_LONG_SECONDS) c-corpus c-seeds
+
+# Benchmarks (not part of make test): writes bench/rust_c/RESULTS.md.
+.PHONY: bench-rust-c
+bench: bench-rust-c
+bench-rust-c: deps cargo-available
+	$(PY) bench/rust_c/run.py
