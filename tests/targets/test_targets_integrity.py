@@ -4,6 +4,7 @@ carry the check, a wrong check is bad_check, reply lines end in *XX), and their 
 from __future__ import annotations
 
 import functools
+import os
 import subprocess
 from pathlib import Path
 
@@ -51,16 +52,9 @@ def test_the_crc8_c_codec_passes_its_tests() -> None:
     assert "agree" in t.run([str(exe), str(tree / "vectors.json")])
 
 
-def test_the_crc8_rust_and_c_stream_parsers_agree_on_checked_frames_and_garbage() -> None:
-    tree = crc8_tree()
-    t.run(["cargo", "build", "--release", "--locked", "--offline", "--quiet"], cwd=tree / "rust",
-          env={"CARGO_TARGET_DIR": str(BUILD / "target")})
-    rlib = BUILD / "target" / "release" / "libdrone_protocol.rlib"
-    rust = BUILD / "stream_driver_rs"
-    t.run(["rustc", "--edition", "2021", "-O", "--extern", f"drone_protocol={rlib}", "-L", str(rlib.parent / "deps"),
-           str(t.DRIVERS / "stream_driver.rs"), "-o", str(rust)])
-    # The shared stream, with a check after each 6-byte piece of every burst of a multiple of 6 bytes (most of
-    # them valid commands); one check in ten is wrong.
+def crc8_stream() -> str:
+    """The shared stream, with a check after each 6-byte piece of every burst of a multiple of 6 bytes (most of
+    them valid commands); one check in ten is wrong."""
     lines = []
     for i, line in enumerate(d.stream_lines(77, 40_000).splitlines()):
         now, _, data = line.partition(" ")
@@ -69,11 +63,36 @@ def test_the_crc8_rust_and_c_stream_parsers_agree_on_checked_frames_and_garbage(
             pieces = [raw[k:k + 6] for k in range(0, len(raw), 6)]
             raw = b"".join(p + (check_text(p).encode() if i % 10 else b"00") for p in pieces)
         lines.append(f"{now} {raw.hex()}")
-    stdin = "\n".join(lines) + "\n"
-    outputs = [_run(exe, stdin) for exe in (rust, c_driver(tree))]
-    assert outputs[0] == outputs[1]
-    errors = d.errors_of(outputs[0][-1])
-    assert errors["bad_check"] > 100 and len(outputs[0]) > 1000, errors
+    return "\n".join(lines) + "\n"
+
+
+@functools.cache
+def crc8_outputs(language: str) -> list[str]:
+    tree = crc8_tree()
+    if language == "python":
+        env = {**os.environ, "PYTHONPATH": str(tree / "python")}
+        proc = subprocess.run(t.python_driver(), input=crc8_stream(), capture_output=True, text=True, timeout=120,
+                              check=True, env=env)
+        return proc.stdout.splitlines()
+    if language == "c":
+        return _run(c_driver(tree), crc8_stream())
+    t.run(["cargo", "build", "--release", "--locked", "--offline", "--quiet"], cwd=tree / "rust",
+          env={"CARGO_TARGET_DIR": str(BUILD / "target")})
+    rlib = BUILD / "target" / "release" / "libdrone_protocol.rlib"
+    rust = BUILD / "stream_driver_rs"
+    t.run(["rustc", "--edition", "2021", "-O", "--extern", f"drone_protocol={rlib}", "-L", str(rlib.parent / "deps"),
+           str(t.DRIVERS / "stream_driver.rs"), "-o", str(rust)])
+    return _run(rust, crc8_stream())
+
+
+def test_the_crc8_rust_and_c_stream_parsers_agree_on_checked_frames_and_garbage() -> None:
+    assert crc8_outputs("rust") == crc8_outputs("c")
+    errors = d.errors_of(crc8_outputs("c")[-1])
+    assert errors["bad_check"] > 100 and errors["out_of_range"] > 100 and len(crc8_outputs("c")) > 1000, errors
+
+
+def test_the_crc8_python_stream_decoder_agrees_with_rust_and_c() -> None:
+    assert crc8_outputs("python") == crc8_outputs("c")
 
 
 def _run(exe: Path, stdin: str) -> list[str]:

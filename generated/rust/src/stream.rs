@@ -5,8 +5,10 @@
 
 use crate::{check_byte, finish, Category, Command, CommandId, Error, Frame, FRAME_LENGTH, INTER_BYTE_TIMEOUT_MS, WIRE_LENGTH};
 
-/// While the buffer holds fewer bytes than this, a digit never completes a frame (the fast path).
-const DIGITS_END: usize = if WIRE_LENGTH > FRAME_LENGTH { FRAME_LENGTH } else { FRAME_LENGTH - 1 };
+
+/// While the buffer holds fewer bytes than this, a digit is a middle digit: it completes neither the frame nor
+/// its value (the fast path).
+const DIGITS_END: usize = FRAME_LENGTH - 1;
 
 /// The error kinds a stream parser meets and counts.
 pub const STREAM_ERRORS: [Error; 5] = [Error::BadCategory, Error::BadDirection, Error::BadDigit, Error::OutOfRange, Error::Timeout, ];

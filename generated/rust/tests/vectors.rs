@@ -167,7 +167,7 @@ impl Reference {
         if b.iter().take(FRAME_LENGTH).skip(2).any(|d| !d.is_ascii_digit()) {
             return Some(Error::BadDigit);
         }
-        if b.len() == WIRE_LENGTH {
+        if b.len() >= FRAME_LENGTH {
             let value: u32 = b[2..FRAME_LENGTH].iter().fold(0, |v, d| v * 10 + u32::from(d - b'0'));
             let info = COMMANDS.iter().find(|c| c.category.code() == b[0] && c.direction == b[1]).unwrap();
             if value < u32::from(info.min) || value > u32::from(info.max) {
