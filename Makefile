@@ -65,6 +65,7 @@ demo: deps generate
 -include pilot/pilot.mk
 -include tests/fuzz/fuzz.mk
 -include bench/bench.mk
+-include tests/targets/targets.mk
 
 clean:
 	rm -rf build firmware/build

@@ -82,7 +82,7 @@ def render_all(spec: Spec) -> dict[str, bytes]:
             for placeholder, value in names.items():
                 out = out.replace(placeholder, value)
             path = f"{target.out_dir}/{out}" if target.out_dir else out
-            files[path] = _with_header(path, text, spec).encode("utf-8")
+            files[path] = (text if target.own_header else _with_header(path, text, spec)).encode("utf-8")
     return files
 
 

@@ -13,6 +13,7 @@ from pathlib import PurePosixPath
 class Target:
     name: str  # the folder of templates under generator/templates/
     out_dir: str  # where its files go, relative to the output folder ("" for the top)
+    own_header: bool = False  # its templates print the do-not-edit header themselves
 
 
 TARGETS: tuple[Target, ...] = (
@@ -21,6 +22,8 @@ TARGETS: tuple[Target, ...] = (
     Target("docs", "docs"),
     Target("vectors", ""),
     Target("ardupilot", "ardupilot"),
+    Target("rust", "rust", own_header=True),  # each template prints the header in its file's own syntax
+    Target("c", "c"),
 )
 
 # How a file carries the header: a line-comment prefix, "<!--" (one block comment), or "json" (no comments:
