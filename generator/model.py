@@ -196,6 +196,12 @@ class Spec:
         return next(r for r in self.replies if r.name == name)
 
     @property
+    def reply_max_length(self) -> int:
+        """The longest reply line in bytes, "\n" included: READY name fingerprint16, or prefix + 2 bytes."""
+        ready = len(self.reply("ready").prefix) + 1 + len(self.name) + 1 + len(self.short_fingerprint) + 1
+        return max(ready, max(len(r.prefix) for r in self.replies) + 3)
+
+    @property
     def digits_width(self) -> int:
         return self.frame_length - 2
 

@@ -15,6 +15,7 @@ from generator.model import Spec
 from generator.names import pascal
 from generator.targets import TARGETS, Target
 from generator.vectors import build_vectors
+from generator.widths import CTYPES
 
 TEMPLATES = Path(__file__).parent / "templates"
 
@@ -63,8 +64,8 @@ def render_all(spec: Spec) -> dict[str, bytes]:
         "frame_errors": FRAME_ERRORS,
         "parser_error_count": sum(1 for e in spec.errors if e.name in PARSER_ERRORS),
         "stream_error_count": len(STREAM_ERRORS),
-        "reply_max_length": max(len(spec.reply("ready").prefix) + len(spec.name) + 19,
-                                max(len(r.prefix) for r in spec.replies) + 3),
+        "reply_max_length": spec.reply_max_length,
+        "ctype": CTYPES,
     }
     files: dict[str, bytes] = {}
     for target in TARGETS:

@@ -327,4 +327,4 @@ def test_an_unreadable_spec_is_an_error_not_a_traceback(tmp_path: Path) -> None:
     binary = tmp_path / "binary.yaml"
     binary.write_bytes(b"\xff\xfe\x00protocol")
     run = h.generate("--spec", binary, "--out", tmp_path / "out")
-    assert run.code == 2 and "cannot read the spec" in run.stderr
+    assert run.code == 2 and "1:1: the spec is not UTF-8 text (byte 0xff)" in run.stderr
