@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TypeVar
 
 from generator import __version__
+from generator.diff import Contract, contract, version_problem
 from generator.errors import SpecError, SpecInvalid
 from generator.model import Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
 from generator.names import identifier_problem, protocol_name_problem, safe_file_name
@@ -34,15 +35,23 @@ def fingerprint(value: object) -> str:
     return hashlib.sha256(canonical.encode("ascii")).hexdigest()
 
 
-def load_spec(path: Path) -> Spec:
-    """Read, validate and build the model of the spec at `path`; raise SpecInvalid with every error."""
+def load_spec(path: Path, previous: Contract | None = None) -> Spec:
+    """Read, validate and build the model of the spec at `path`; raise SpecInvalid with every error.
+
+    `previous`: the contract generated last; the spec's version must rise if it breaks that contract."""
     text, errors = read(path)
     if text is None:
         raise SpecInvalid(errors)
     root, errors = load(text, display_path(path))
     if root is None:
         raise SpecInvalid(errors)
-    spec = _Builder(root, safe_file_name(path), errors).build()
+    builder = _Builder(root, safe_file_name(path), errors)
+    spec = builder.build()
+    if spec is not None and previous is not None:
+        problem = version_problem(previous, contract(spec))
+        if problem:
+            errors.append(SpecError(builder.node_at("protocol.version").location, "protocol.version", problem,
+                                    "raise protocol.version; `python -m generator diff` lists the changes"))
     if errors or spec is None:
         raise SpecInvalid(errors)
     return spec
@@ -149,11 +158,11 @@ class _Builder:
             settled=tuple(settled),
         )
         for path, message in overflows(spec):
-            node = self._node_at(path)
+            node = self.node_at(path)
             self.errors.append(SpecError(node.location, path, message, "the generated C++ would hold another number"))
         return None if self.errors else spec
 
-    def _node_at(self, path: str) -> Node:
+    def node_at(self, path: str) -> Node:
         """The node the spec writes at dotted `path` (or its nearest parent that exists)."""
         node = self.root
         for key in path.split("."):

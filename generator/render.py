@@ -11,6 +11,7 @@ import jinja2
 
 from generator import filters
 from generator.build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
+from generator.diff import contract
 from generator.model import Spec
 from generator.names import pascal
 from generator.targets import TARGETS, Target
@@ -46,6 +47,8 @@ def _environment(target: Target) -> jinja2.Environment:
         keep_trailing_newline=True,
         autoescape=False,
     )
+    if target.escape == "html":
+        env.finalize = filters.html_text
     env.filters.update(filters.ALL)
     return env
 
@@ -65,6 +68,7 @@ def render_all(spec: Spec) -> dict[str, bytes]:
         "parser_error_count": sum(1 for e in spec.errors if e.name in PARSER_ERRORS),
         "stream_error_count": len(STREAM_ERRORS),
         "reply_max_length": spec.reply_max_length,
+        "contract_json": json.dumps(contract(spec), indent=2, sort_keys=True).replace("\n", "\n  "),
         "ctype": CTYPES,
     }
     files: dict[str, bytes] = {}
