@@ -51,7 +51,8 @@ def load_spec(path: Path, previous: Contract | None = None) -> Spec:
         problem = version_problem(previous, contract(spec))
         if problem:
             errors.append(SpecError(builder.node_at("protocol.version").location, "protocol.version", problem,
-                                    "raise protocol.version; `python -m generator diff` lists the changes"))
+                                    "raise protocol.version (`python -m generator diff` lists the changes); "
+                                    "to undo a generated edit, restore generated/ too (git checkout generated)"))
     if errors or spec is None:
         raise SpecInvalid(errors)
     return spec

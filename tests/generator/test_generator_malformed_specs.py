@@ -281,7 +281,7 @@ def check(case: Case, tmp_path: Path, expected: list[str]) -> None:
     spec = tmp_path / "drone.yaml"
     spec.write_text(case.spec(), encoding="utf-8")
     out = tmp_path / "generated"
-    shutil.copytree(h.GENERATED, out)
+    shutil.copytree(h.fixture_generated(), out)
     before = h.tree(out)
     run = h.generate("--spec", spec, "--out", out)
     count = len(expected)
