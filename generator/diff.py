@@ -22,13 +22,13 @@ def contract(spec: Spec) -> Contract:
     return {
         "name": spec.name,
         "version": spec.version,
-        "frame": {"length": spec.frame_length, "encoding": "ascii",
-                  "integrity": getattr(spec, "integrity", "none"),
-                  "inter_byte_timeout_ms": spec.inter_byte_timeout_ms},
+        "frame": {"length": spec.frame_length, "encoding": "ascii", "integrity": spec.integrity,
+                  "wire_length": spec.wire_length, "inter_byte_timeout_ms": spec.inter_byte_timeout_ms},
         "link": {"baud": spec.baud, "data_bits": spec.data_bits, "parity": spec.parity, "stop_bits": spec.stop_bits,
                  "ready_timeout_ms": spec.ready_timeout_ms},
         "timing": {"command_timeout_ms": spec.command_timeout_ms, "failsafe_timeout_ms": spec.failsafe_timeout_ms,
-                   "failsafe_throttle_us": spec.failsafe_throttle_us, "arming_hold_ms": spec.arming_hold_ms},
+                   "failsafe_throttle_us": spec.failsafe_throttle_us, "arming_hold_ms": spec.arming_hold_ms,
+                   "landing_ms": spec.landing_ms},
         "commands": {
             cmd.category.code + cmd.direction.code: {
                 "name": cmd.direction.command, "min": cmd.direction.minimum, "max": cmd.direction.maximum,
@@ -39,6 +39,11 @@ def contract(spec: Spec) -> Contract:
         },
         "errors": {e.name: {"code": e.code, "description": e.description} for e in spec.errors},
         "replies": {r.name: {"prefix": r.prefix, "description": r.description} for r in spec.replies},
+        # every accepted/rejected/failsafe line ends with separator, state code, laser code
+        "status": {"separator": spec.status.separator, "laser_off": spec.status.laser_off,
+                   "laser_on": spec.status.laser_on},
+        "states": {st.name: {"code": st.code, "armed": st.armed, "description": st.description}
+                   for st in spec.status.states},
         "texts": {"title": spec.title, "description": spec.description},
     }
 
@@ -59,8 +64,9 @@ def diff(old: Contract, new: Contract) -> list[Change]:
         changes.append(Change(True, f"protocol name {old.get('name')} -> {new.get('name')} (the ready line)"))
     _sections(old, new, changes)
     _entries(old, new, "commands", changes, _command_change)
-    _entries(old, new, "errors", changes, _keyed_change("code", "error"))
-    _entries(old, new, "replies", changes, _keyed_change("prefix", "reply"))
+    _entries(old, new, "errors", changes, _keyed_change("error", "code"))
+    _entries(old, new, "replies", changes, _keyed_change("reply", "prefix"))
+    _entries(old, new, "states", changes, _keyed_change("state", "code", "armed"))
     old_names = {c["name"]: code for code, c in old.get("commands", {}).items()}
     for code, cmd in new.get("commands", {}).items():
         was = old.get("commands", {}).get(code)
@@ -73,14 +79,17 @@ def diff(old: Contract, new: Contract) -> list[Change]:
 # frame and link: any change breaks a peer, but for these (timeout rising: a slow peer still fits).
 _TOLERANT = {("frame", "inter_byte_timeout_ms"): "rise", ("link", "ready_timeout_ms"): "any",
              ("timing", "command_timeout_ms"): "any", ("timing", "failsafe_timeout_ms"): "rise",
-             ("timing", "failsafe_throttle_us"): "any", ("timing", "arming_hold_ms"): "any"}
+             ("timing", "failsafe_throttle_us"): "any", ("timing", "arming_hold_ms"): "any",
+             ("timing", "landing_ms"): "any"}
 
 
 def _sections(old: Contract, new: Contract, changes: list[Change]) -> None:
-    for section in ("frame", "link", "timing", "texts"):
-        before, after = old.get(section, {}), new.get(section, {})
-        for key in sorted(set(before) | set(after)):
-            a, b = before.get(key), after.get(key)
+    for section in ("frame", "link", "status", "timing", "texts"):
+        if section not in old or section not in new:
+            continue  # a contract written before the section existed: nothing to compare
+        before, after = old[section], new[section]
+        for key in sorted(before):  # a key the old contract does not record is not compared
+            a, b = before[key], after.get(key)
             if a == b:
                 continue
             rule = "any" if section == "texts" else _TOLERANT.get((section, key), "never")
@@ -91,7 +100,9 @@ def _sections(old: Contract, new: Contract, changes: list[Change]) -> None:
 
 def _entries(old: Contract, new: Contract, section: str, changes: list[Change],
              compare: Callable[[str, Mapping[str, Any], Mapping[str, Any]], list[Change]]) -> None:
-    before, after = old.get(section, {}), new.get(section, {})
+    if section not in old or section not in new:
+        return
+    before, after = old[section], new[section]
     noun = section[:-1]
     for key in sorted(set(before) | set(after)):
         a, b = before.get(key), after.get(key)
@@ -119,11 +130,11 @@ def _command_change(code: str, a: Mapping[str, Any], b: Mapping[str, Any]) -> li
     return out
 
 
-def _keyed_change(key: str, noun: str) -> Callable[[str, Mapping[str, Any], Mapping[str, Any]], list[Change]]:
+def _keyed_change(noun: str, *keys: str) -> Callable[[str, Mapping[str, Any], Mapping[str, Any]], list[Change]]:
+    """Compare two entries of a section: a change of one of `keys` breaks a peer, of the description not."""
     def compare(name: str, a: Mapping[str, Any], b: Mapping[str, Any]) -> list[Change]:
-        out = []
-        if a[key] != b[key]:
-            out.append(Change(True, f"{noun} {name}: {key} {a[key]!r} -> {b[key]!r}"))
+        out = [Change(True, f"{noun} {name}: {key} {a.get(key)!r} -> {b.get(key)!r}")
+               for key in keys if a.get(key) != b.get(key)]
         if a.get("description") != b.get("description"):
             out.append(Change(False, f"{noun} {name}: description {a.get('description')!r} -> "
                                      f"{b.get('description')!r}"))

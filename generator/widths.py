@@ -42,6 +42,7 @@ SCALARS: Mapping[str, tuple[CType, str, str]] = MappingProxyType({
     "FAILSAFE_TIMEOUT_MS": (UINT16, "failsafe_timeout_ms", "safety.failsafe_timeout_ms"),
     "FAILSAFE_THROTTLE_US": (UINT16, "failsafe_throttle_us", "safety.failsafe_throttle_us"),
     "ARMING_HOLD_MS": (UINT16, "arming_hold_ms", "safety.arming_hold_ms"),
+    "LANDING_MS": (UINT16, "landing_ms", "safety.landing_ms"),
     "MODE_STABILIZE_US": (UINT16, "mode_stabilize_us", "flight_modes.stabilize_us"),
     "MODE_ALT_HOLD_US": (UINT16, "mode_alt_hold_us", "flight_modes.alt_hold_us"),
     "SPEED_STEP_US": (UINT16, "speed_step_us", "speeds.step_us"),
