@@ -15,7 +15,6 @@ from generator import __version__
 from generator.build import load_spec
 from generator.diff import Contract, contract, diff
 from generator.errors import SpecInvalid
-from generator.render import render_all, stale_files, write_atomically
 from generator.source import display_path
 
 EXIT_STALE = 1
@@ -42,6 +41,8 @@ def main(argv: list[str] | None = None) -> int:
     except SpecInvalid as exc:
         _report(shown, exc)
         return EXIT_INVALID
+    from generator.render import render_all, stale_files, write_atomically  # Jinja only for a valid spec
+
     files = render_all(spec)
     if opts.check:
         problems = stale_files(files, opts.out)
