@@ -5,18 +5,26 @@
 #                         bench/protocol/RESULTS.md
 #   make bench-generator  generator time for the shipped and a 676-command spec, rejecting hostile specs;
 #                         writes bench/generator/RESULTS.md
+#   make bench-vision     the detectors on real photographs (scikit-image's) under 10 conditions, empty and
+#                         distractor views, tuning and held-out photos, time vs the cvtColor+inRange floor;
+#                         writes bench/vision/RESULTS.md (BENCH_VISION_FLAGS=--quick for a smoke run)
 #   make bench            every part's benchmark: bench-protocol, bench-generator, bench-firmware
-#                         (firmware/firmware.mk) and bench-pilot (pilot/pilot.mk)
+#                         (firmware/firmware.mk), bench-pilot (pilot/pilot.mk) and bench-vision
 #
 # BENCH_PROTOCOL_FLAGS=--quick for a smoke run (fewer repetitions; still writes RESULTS.md unless --no-write).
 
 BENCH_PROTOCOL_BUILD ?= build/bench/protocol
 BENCH_PROTOCOL_FLAGS ?=
 
-.PHONY: bench bench-protocol bench-generator bench-firmware bench-pilot
+BENCH_VISION_FLAGS ?=
+
+.PHONY: bench bench-protocol bench-generator bench-firmware bench-pilot bench-vision
 
 # Run benchmarks one at a time (not with make -j): they time each other otherwise.
-bench: bench-protocol bench-generator bench-firmware bench-pilot
+bench: bench-protocol bench-generator bench-firmware bench-pilot bench-vision
+
+bench-vision: deps
+	PYTHONPATH=bench/vision $(PY) bench/vision/run.py $(BENCH_VISION_FLAGS)
 
 bench-protocol: deps
 	$(PY) bench/protocol/run.py --build $(BENCH_PROTOCOL_BUILD) $(BENCH_PROTOCOL_FLAGS)

@@ -79,4 +79,5 @@ ALL: dict[str, Callable[..., Any]] = {
     "frame_text": frame_text,
     "wrap": wrap,
     "tojson": lambda v: json.dumps(v, sort_keys=True),
+    "add_suffix": lambda text, suffix: f"{text}{suffix}",
 }

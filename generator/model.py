@@ -251,6 +251,13 @@ class Spec:
     def error(self, name: str) -> ErrorKind:
         return next(e for e in self.errors if e.name == name)
 
+    def wire(self, text: str) -> str:
+        """A frame or reply line as it goes on the wire: with its check in crc8 mode (a reply's after '*')."""
+        if self.integrity == "none":
+            return text
+        data = text.encode("ascii")
+        return text + check_text(data) if len(data) == self.frame_length else text + "*" + check_text(data)
+
 
 # frame.integrity modes and the check characters each appends to a frame.
 CHECK_LENGTH = {"none": 0, "crc8": 2}

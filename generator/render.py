@@ -65,6 +65,7 @@ def render_all(spec: Spec) -> dict[str, bytes]:
              "generator": spec.generator_version}, sort_keys=True),
         "library": pascal(spec.name),
         "frame_errors": FRAME_ERRORS,
+        "raised_errors": (*FRAME_ERRORS, "bad_check"),  # the error kinds decode() raises as exceptions
         "parser_error_count": sum(1 for e in spec.errors if e.name in PARSER_ERRORS),
         "stream_error_count": len(STREAM_ERRORS),
         "reply_max_length": spec.reply_max_length,
