@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import html
 import json
 import textwrap
 from collections.abc import Callable
@@ -9,6 +10,17 @@ from typing import Any
 
 from generator.model import check_text
 from generator.names import pascal
+
+
+class Safe(str):
+    """Text a filter already made safe for its target (e.g. Markdown code): not escaped again."""
+
+
+def html_text(value: object) -> object:
+    """Jinja's finalize for Markdown: spec text never becomes HTML (`<img onerror=...>` prints as text)."""
+    if isinstance(value, str) and not isinstance(value, Safe):
+        return html.escape(value, quote=False)
+    return value
 
 
 def cpp_char(code: str) -> str:
@@ -75,7 +87,7 @@ def md_cell(text: str) -> str:
 
 def md_code(text: str) -> str:
     """Inline Markdown code that survives backticks and surrounding spaces."""
-    return f"`` {text} ``" if "`" in text or text != text.strip() else f"`{text}`"
+    return Safe(f"`` {text} ``" if "`" in text or text != text.strip() else f"`{text}`")
 
 
 def frame_text(frame: bytes) -> str:

@@ -264,6 +264,15 @@ class Spec:
         return next(r for r in self.replies if r.name == name)
 
     @property
+    def reply_max_length(self) -> int:
+        """The longest reply line in bytes, "\n" included: `READY name fingerprint16 integrity`, or a prefix, two
+        bytes (category and direction, or an error code) and the status; each with "*XX" in crc8 mode."""
+        check = 1 + self.check_length if self.check_length else 0
+        ready = (len(self.reply("ready").prefix) + 1 + len(self.name) + 1 + len(self.short_fingerprint) + 1
+                 + len(self.integrity) + check + 1)
+        return max(ready, max(len(r.prefix) for r in self.replies) + 2 + self.status.length + check + 1)
+
+    @property
     def digits_width(self) -> int:
         return self.frame_length - 2
 

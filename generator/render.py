@@ -11,10 +11,12 @@ import jinja2
 
 from generator import ardupilot, filters
 from generator.build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
+from generator.diff import contract
 from generator.model import Spec
 from generator.names import pascal
 from generator.targets import TARGETS, Target, comment_style
 from generator.vectors import build_vectors
+from generator.widths import CTYPES
 
 TEMPLATES = Path(__file__).parent / "templates"
 
@@ -46,6 +48,8 @@ def _environment(target: Target) -> jinja2.Environment:
         keep_trailing_newline=True,
         autoescape=False,
     )
+    if target.escape == "html":
+        env.finalize = filters.html_text
     env.filters.update(filters.ALL)
     return env
 
@@ -66,8 +70,9 @@ def render_all(spec: Spec) -> dict[str, bytes]:
         "raised_errors": (*FRAME_ERRORS, "bad_check"),  # the error kinds decode() raises as exceptions
         "parser_error_count": sum(1 for e in spec.errors if e.name in PARSER_ERRORS),
         "stream_error_count": len(STREAM_ERRORS),
-        "reply_max_length": max(len(spec.reply("ready").prefix) + len(spec.name) + 19,
-                                max(len(r.prefix) for r in spec.replies) + 3),
+        "reply_max_length": spec.reply_max_length,
+        "contract_json": json.dumps(contract(spec), indent=2, sort_keys=True).replace("\n", "\n  "),
+        "ctype": CTYPES,
     }
     files: dict[str, bytes] = {}
     for target in TARGETS:

@@ -14,13 +14,16 @@ class Target:
     name: str  # the folder of templates under generator/templates/
     out_dir: str  # where its files go, relative to the output folder ("" for the top)
     own_header: bool = False  # its templates print the do-not-edit header themselves
+    # "html": every printed value is HTML-escaped (& < >) unless a filter already made it safe (filters.Safe)
+    escape: str = ""
 
 
 TARGETS: tuple[Target, ...] = (
     Target("python", "python"),
     Target("arduino", "arduino"),
-    Target("docs", "docs"),
+    Target("docs", "docs", escape="html"),
     Target("vectors", ""),
+    Target("contract", ""),  # what a peer relies on: the previous version for the breaking-change check
     Target("ardupilot", "ardupilot"),
     Target("rust", "rust", own_header=True),  # each template prints the header in its file's own syntax
     Target("c", "c"),

@@ -96,7 +96,8 @@ def _malformed(spec: Spec) -> list[Vector]:
     out.append(_invalid(b"\xff" + good[1:], "bad_category", 0, "a byte above ASCII as category"))
     for cat in spec.categories:
         taken = {d.code for d in cat.directions}
-        bad = next(c for c in "zqZ9" + string.ascii_letters if c not in taken)
+        # a space is never a code: the fallback when a category takes every printable character
+        bad = next(c for c in "zqZ9" + string.ascii_letters + string.punctuation + " " if c not in taken)
         d = cat.directions[0]
         frame = d.frame(cat.code, d.default_frame_value).encode()
         out.append(_invalid(frame[:1] + bad.encode() + frame[2:], "bad_direction", 1,

@@ -286,7 +286,7 @@ def check(case: Case, tmp_path: Path, expected: list[str]) -> None:
     spec = tmp_path / "drone.yaml"
     spec.write_text(case.spec(), encoding="utf-8")
     out = tmp_path / "generated"
-    shutil.copytree(h.GENERATED, out)
+    shutil.copytree(h.fixture_generated(), out)
     before = h.tree(out)
     run = h.generate("--spec", spec, "--out", out)
     count = len(expected)
@@ -332,4 +332,4 @@ def test_an_unreadable_spec_is_an_error_not_a_traceback(tmp_path: Path) -> None:
     binary = tmp_path / "binary.yaml"
     binary.write_bytes(b"\xff\xfe\x00protocol")
     run = h.generate("--spec", binary, "--out", tmp_path / "out")
-    assert run.code == 2 and "cannot read the spec" in run.stderr
+    assert run.code == 2 and "1:1: the spec is not UTF-8 text (byte 0xff)" in run.stderr

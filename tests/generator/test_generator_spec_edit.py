@@ -165,8 +165,8 @@ def edited(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def test_the_edited_spec_has_a_new_fingerprint(edited: Path) -> None:
-    assert load_spec(edited / "drone.yaml").fingerprint != load_spec(h.SPEC).fingerprint
-    run = h.generate("--spec", edited / "drone.yaml", "--out", h.GENERATED, "--check")  # now stale
+    assert load_spec(edited / "drone.yaml").fingerprint != load_spec(h.FIXTURE).fingerprint
+    run = h.generate("--spec", edited / "drone.yaml", "--out", h.fixture_generated(), "--check")  # now stale
     assert run.code == 1
 
 

@@ -795,7 +795,7 @@ void dispatch(const Command& command, Handler& handler) {
 }
 
 // Replies (Arduino -> Pi): each writes one line ending in '\n' into `out` and returns its length.
-constexpr uint8_t REPLY_MAX_LENGTH = 39;
+constexpr uint8_t REPLY_MAX_LENGTH = 44;
 
 namespace detail {
 DRONE_PROTOCOL_FLASH const char READY_LINE[] = "#READY drone_protocol d959f83c9f2e389b\n";
