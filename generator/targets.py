@@ -51,6 +51,7 @@ COMMENT_BY_SUFFIX = {
     ".md": "<!--",
     ".html": "<!--",
     ".json": "json",
+    ".lock": "#",  # Cargo.lock
 }
 
 

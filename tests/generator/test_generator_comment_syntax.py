@@ -15,7 +15,7 @@ from generator.targets import comment_style
 
 # What each format accepts as a comment: the header's first line must start with it.
 OPENERS = {".properties": "# ", ".txt": "# ", ".parm": "# ", ".py": "# ", ".typed": "# ", ".h": "// ",
-           ".ino": "// ", ".md": "<!--\n"}
+           ".ino": "// ", ".md": "<!--\n", ".c": "// ", ".rs": "// ", ".toml": "# ", ".lock": "# "}
 
 
 def test_every_generated_file_opens_with_its_own_formats_comment() -> None:

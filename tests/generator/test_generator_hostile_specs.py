@@ -157,9 +157,10 @@ CASES = [
     Hostile("protocol name with a newline and code", edited((NAME, '  name: "x\\n#define static_assert(x)"')),
             (("protocol:\n  name: ^", "protocol.name: 'x #define static_assert(x)' is not a lower_snake_case"),)),
     # -- numbers bounded by their C++ type -----------------------------------------------------------------------
+    # Past uint16_t, and so past the flight controller's failsafe band: one mistake, reported once, where it is.
     Hostile("failsafe throttle past uint16_t", edited(("  failsafe_throttle_us: 950", "  failsafe_throttle_us: 66486")),
-            (("failsafe_throttle_us: ^66486", "safety.failsafe_throttle_us: FAILSAFE_THROTTLE_US = 66486 does not fit "
-              f"its C++ type uint16_t (0..65535) {FITS}"),)),
+            (("failsafe_throttle_us: ^66486", "safety.failsafe_throttle_us: no flight-controller FS_THR_VALUE fits "
+              "strictly between failsafe_throttle_us 66486 and the throttle minimum 1029"),)),
     Hostile("version past uint16_t", edited(("  version: 1", "  version: 70000")),
             (("version: ^70000", "protocol.version: PROTOCOL_VERSION = 70000 does not fit its C++ type uint16_t"),)),
     Hostile("baud past uint32_t", edited(("  baud: 115200", "  baud: 5000000000")),
@@ -186,7 +187,8 @@ CASES = [
             (("  pan:\n    ^description",
               "servos.pan: SERVO_PAN_MAX = 300 does not fit its C++ type uint8_t (0..255)"),)),
     Hostile("a channel no command drives, past uint16_t",
-            edited(("channels:\n", "channels:\n  aux:\n    recorded: [1000, 70000]\n    movement: none\n")),
+            edited(("channels:\n", "channels:\n  aux:\n    recorded: [1000, 70000]\n    movement: none\n"),
+                   ("  rc_inputs:\n", "  rc_inputs:\n    aux: 7\n")),
             (("  aux:\n    recorded: ^[",
               "channels.aux.recorded: AUX_MAX = 70000 does not fit its C++ type uint16_t"),)),
     Hostile("a reply prefix that overflows REPLY_MAX_LENGTH",
