@@ -9,12 +9,12 @@ from pathlib import Path
 
 import jinja2
 
-from generator import filters
-from generator.build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
-from generator.model import Spec
-from generator.names import pascal
-from generator.targets import TARGETS, Target
-from generator.vectors import build_vectors
+from . import filters
+from .build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
+from .model import Spec
+from .names import pascal
+from .targets import TARGETS, Target
+from .vectors import build_vectors
 
 TEMPLATES = Path(__file__).parent / "templates"
 
@@ -27,13 +27,18 @@ def header_lines(spec: Spec) -> list[str]:
     ]
 
 
-def _with_header(target: Target, text: str, spec: Spec) -> str:
+# Files whose format has its own comment syntax, whatever their target's (a README.md in the Python package).
+COMMENT_BY_SUFFIX = {".md": "<!--"}
+
+
+def _with_header(target: Target, text: str, spec: Spec, path: str) -> str:
     lines = header_lines(spec)
-    if target.comment == "json":
+    comment = COMMENT_BY_SUFFIX.get(Path(path).suffix, target.comment)
+    if comment == "json":
         return text  # JSON has no comments: its template prints the header as its first member
-    if target.comment == "<!--":
+    if comment == "<!--":
         return "<!--\n" + "\n".join(lines) + "\n-->\n" + text
-    return "".join(f"{target.comment} {line}\n" for line in lines) + text
+    return "".join(f"{comment} {line}\n" for line in lines) + text
 
 
 def _environment(target: Target) -> jinja2.Environment:
@@ -72,14 +77,14 @@ def render_all(spec: Spec) -> dict[str, bytes]:
         root = TEMPLATES / target.name
         for template_path in sorted(root.rglob("*.j2")):
             rel = template_path.relative_to(root).as_posix()
-            if template_path.name.startswith("_"):
-                continue  # a partial, included by another template of the folder
+            if template_path.name.startswith("_") and not template_path.name.startswith("__"):
+                continue  # a partial, included by another template of the folder (__init__.py.j2 is not one)
             text = env.get_template(rel).render(context)
             out = rel[: -len(".j2")]
             for placeholder, value in names.items():
                 out = out.replace(placeholder, value)
             path = f"{target.out_dir}/{out}" if target.out_dir else out
-            files[path] = _with_header(target, text, spec).encode("utf-8")
+            files[path] = _with_header(target, text, spec, path).encode("utf-8")
     return files
 
 
