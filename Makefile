@@ -32,10 +32,14 @@ $(APT_STAMP):
 	fi
 	@mkdir -p $(dir $@) && touch $@
 
-$(VENV_STAMP): pyproject.toml
+# The codec (generated/python, its own distribution) first, then the project, which depends on it; both editable.
+$(VENV_STAMP): pyproject.toml setup.py generated/python/pyproject.toml
 	@test -x $(PY) || $(PYTHON_SYSTEM) -m venv $(VENV)
-	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e '.[dev]'
+	@echo "Installing the Python environment in $(VENV) (the codec, the project and its dev tools)"
+	@mkdir -p build
+	@# pip's and setuptools' chatter goes to a log, shown only when the install fails
+	@{ $(PY) -m pip install -q --upgrade pip && $(PY) -m pip install -q -e generated/python -e '.[dev]'; } \
+	  >build/pip-install.log 2>&1 || { cat build/pip-install.log; echo "pip install failed (log: build/pip-install.log)"; exit 1; }
 	@touch $@
 
 generate: $(VENV_STAMP)

@@ -8,12 +8,12 @@ import json
 from pathlib import Path
 from typing import TypeVar
 
-from generator import __version__
-from generator.errors import SpecError, SpecInvalid
-from generator.model import Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
-from generator.names import identifier_problem
-from generator.reader import Reader, is_int, kind_name
-from generator.source import INVALID, Node, load
+from . import __version__
+from .errors import SpecError, SpecInvalid
+from .model import Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
+from .names import identifier_problem
+from .reader import Reader, is_int, kind_name
+from .source import INVALID, Node, load
 
 T = TypeVar("T")
 
@@ -39,7 +39,7 @@ def load_spec(path: Path) -> Spec:
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        from generator.errors import Location
+        from .errors import Location
 
         raise SpecInvalid([SpecError(Location(str(path), 1, 1), "", f"cannot read the spec: {exc}")]) from exc
     root, errors = load(text, str(path))

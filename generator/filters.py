@@ -7,7 +7,7 @@ import textwrap
 from collections.abc import Callable
 from typing import Any
 
-from generator.names import pascal
+from .names import pascal
 
 
 def cpp_char(code: str) -> str:

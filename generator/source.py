@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import yaml
 
-from generator.errors import Location, SpecError
+from .errors import Location, SpecError
 
 
 class Invalid:

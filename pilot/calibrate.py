@@ -14,9 +14,9 @@ import cv2
 import numpy as np
 from cv2.typing import MatLike
 
-from pilot import config as config_mod
-from pilot.config import HsvRange, PilotConfig
-from pilot.errors import ConfigError
+from . import config as config_mod
+from .config import HsvRange, PilotConfig
+from .errors import ConfigError
 
 Roi = tuple[int, int, int, int]  # x, y, w, h
 

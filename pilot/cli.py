@@ -19,19 +19,19 @@ from types import FrameType
 
 import drone_protocol as dp
 
-from pilot import config as config_mod
-from pilot.calibrate import Roi, calibrate_to_config
-from pilot.config import PilotConfig
-from pilot.controller import Controller, State
-from pilot.detect import make_detector
-from pilot.errors import PilotError
-from pilot.link import Link, LogEntry, keepalive_ms
-from pilot.record import Recorder
-from pilot.runner import DryRunSink, Observer, RealPacer, Sink, StatusLine, run
-from pilot.sim.camera import CameraModel, CameraPose, Renderer
-from pilot.sim.flight import fly
-from pilot.sim.room import SCENARIOS, make_scenario
-from pilot.sources import CameraSource, Frame, FrameSource, ImageFolderSource, VideoFileSource
+from . import config as config_mod
+from .calibrate import Roi, calibrate_to_config
+from .config import PilotConfig
+from .controller import Controller, State
+from .detect import make_detector
+from .errors import PilotError
+from .link import Link, LogEntry, keepalive_ms
+from .record import Recorder
+from .runner import DryRunSink, Observer, RealPacer, Sink, StatusLine, run
+from .sim.camera import CameraModel, CameraPose, Renderer
+from .sim.flight import fly
+from .sim.room import SCENARIOS, make_scenario
+from .sources import CameraSource, Frame, FrameSource, ImageFolderSource, VideoFileSource
 
 EXIT_OK = 0
 EXIT_FAILED = 1

@@ -39,8 +39,8 @@ from dataclasses import dataclass
 
 import drone_protocol as dp
 
-from pilot.config import ControllerConfig
-from pilot.detect import Detection
+from .config import ControllerConfig
+from .detect import Detection
 
 
 class State(enum.Enum):

@@ -16,8 +16,8 @@ import numpy as np
 import numpy.typing as npt
 from cv2.typing import MatLike
 
-from pilot.config import ArucoConfig, HsvConfig, PilotConfig
-from pilot.errors import ConfigError
+from .config import ArucoConfig, HsvConfig, PilotConfig
+from .errors import ConfigError
 
 
 @dataclass(frozen=True)

@@ -18,10 +18,10 @@ import cv2
 import drone_protocol as dp
 import numpy as np
 
-from pilot.closing import Closing
-from pilot.link import LogEntry
-from pilot.runner import Tick
-from pilot.sim.room import Scenario
+from .closing import Closing
+from .link import LogEntry
+from .runner import Tick
+from .sim.room import Scenario
 
 VIDEO = "flight.avi"
 LOG = "log.jsonl"

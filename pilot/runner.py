@@ -22,10 +22,10 @@ from typing import Protocol, TextIO
 
 import drone_protocol as dp
 
-from pilot.controller import Controller, State
-from pilot.detect import Detection, Detector
-from pilot.errors import FrameSourceError
-from pilot.sources import Frame, FrameSource
+from .controller import Controller, State
+from .detect import Detection, Detector
+from .errors import FrameSourceError
+from .sources import Frame, FrameSource
 
 
 class Sink(Protocol):

@@ -17,8 +17,8 @@ from typing import Protocol, Self
 import cv2
 from cv2.typing import MatLike
 
-from pilot.closing import Closing
-from pilot.errors import FrameSourceError
+from .closing import Closing
+from .errors import FrameSourceError
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".ppm", ".pgm", ".tif", ".tiff")
 
