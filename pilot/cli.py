@@ -19,6 +19,7 @@ from types import FrameType
 
 import drone_protocol as dp
 
+from . import __version__
 from . import config as config_mod
 from .calibrate import Roi, calibrate_to_config
 from .config import PilotConfig
@@ -41,6 +42,8 @@ EXIT_INTERRUPTED = 130
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="pilot", description="The Raspberry Pi vision pilot of the drone.")
+    p.add_argument("--version", action="version", version=f"pilot {__version__} (protocol {dp.PROTOCOL_NAME} "
+                   f"{dp.PROTOCOL_VERSION}, spec fingerprint {dp.SPEC_FINGERPRINT})")
     where = p.add_argument_group("where to fly")
     where.add_argument("--sim", action="store_true", help="fly the simulated room (the default without --port)")
     where.add_argument("--port", help="serial port or pyserial URL of the drone's Arduino (e.g. /dev/ttyACM0)")
