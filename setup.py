@@ -12,5 +12,5 @@ found = [p for p in find_namespace_packages(include=["generator", "generator.*",
 setup(
     packages=[f"{NAMESPACE}.{p}" for p in found],
     package_dir={f"{NAMESPACE}.{p}": p.replace(".", "/") for p in found},
-    package_data={f"{NAMESPACE}.{p}": ["py.typed", "*.j2", "**/*.j2"] for p in found},
+    package_data={f"{NAMESPACE}.{p}": ["py.typed", "*.j2", "**/*.j2", "*.html"] for p in found},
 )

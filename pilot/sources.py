@@ -59,7 +59,6 @@ class FrameSourceBase(Closing):
         self._closed = True
 
 
-
 class CameraSource(FrameSourceBase):
     """A V4L2/OpenCV camera (index or device path) with a one-frame buffer, so that decisions use
     the newest image rather than one up to ~130 ms old. ``max_failures`` consecutive failed reads
@@ -136,6 +135,24 @@ class ImageFolderSource(FrameSourceBase):
         if not self._paths:
             raise FrameSourceError(f"image folder {str(self.folder)!r}: holds no images ({', '.join(IMAGE_SUFFIXES)})")
         self._next = 0
+        self._check_sizes()
+
+    def _check_sizes(self) -> None:
+        """One size for every image, checked before the first frame: a recording and the detector's
+        geometry need it, and a failure halfway through a run would leave half a recording."""
+        first: tuple[str, tuple[int, ...]] | None = None
+        for path in self._paths:
+            image = cv2.imread(str(path), cv2.IMREAD_COLOR)
+            if image is None:
+                raise FrameSourceError(f"option --images: cannot decode {str(path)!r}: remove it or fix it")
+            if first is None:
+                first = (path.name, image.shape[:2])
+            elif image.shape[:2] != first[1]:
+                h, w = image.shape[:2]
+                raise FrameSourceError(
+                    f"option --images: {path.name!r} is {w}x{h} but {first[0]!r} is {first[1][1]}x{first[1][0]}: "
+                    "every image of the folder must have one size"
+                )
 
     def read(self) -> Frame | None:
         if self._closed or self._next >= len(self._paths):

@@ -31,6 +31,8 @@ def _wheel(source: Path, out: Path) -> Path:
     shutil.copytree(source, copy, ignore=shutil.ignore_patterns("__pycache__", ".venv", "build", "*.egg-info"))
     proc = _run(sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", out / "dist", copy, cwd=out)
     assert proc.returncode == 0, proc.stdout + proc.stderr
+    # quiet: no setuptools warnings such as "Package 'generator.templates...' would be ignored"
+    assert "Warning" not in proc.stdout + proc.stderr, proc.stdout + proc.stderr
     (wheel,) = (out / "dist").glob("*.whl")
     return wheel
 
