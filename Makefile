@@ -9,9 +9,11 @@ PY := $(VENV)/bin/python
 VENV_STAMP := $(VENV)/.installed
 APT_STAMP := build/.apt-packages
 
-# Debian 12 packages: the AVR toolchain and Arduino core, simavr, host compilers, clang + libFuzzer, valgrind.
+# Debian 12 packages: the AVR toolchain and Arduino core, simavr, host compilers, clang + libFuzzer, valgrind,
+# Chromium and its WebDriver (the live view's browser test).
 APT_PACKAGES := make gcc g++ python3 python3-venv python3-pip gcc-avr binutils-avr avr-libc arduino-core-avr \
-                simavr libsimavr-dev libelf-dev pkg-config clang libclang-rt-14-dev valgrind
+                simavr libsimavr-dev libelf-dev pkg-config clang libclang-rt-14-dev valgrind \
+                chromium chromium-driver
 
 .PHONY: all demo test deps generate check-generated lint typecheck pytest fuzz fuzz-smoke bench clean
 
@@ -19,7 +21,7 @@ all: generate
 
 deps: $(APT_STAMP) $(VENV_STAMP)
 
-$(APT_STAMP):
+$(APT_STAMP): Makefile
 	@missing=$$(for p in $(APT_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null \
 	    | grep -q "install ok installed" || echo $$p; done); \
 	if [ -n "$$missing" ]; then \
