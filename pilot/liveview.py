@@ -39,6 +39,7 @@ from .runner import Tick
 BOUNDARY = "liveviewframe"
 HISTORY = 12  # commands shown on the page
 JPEG_QUALITY = 80
+MAX_FPS = 25.0  # per viewer: the camera's rate is 20 Hz; an unpaced (simulated) loop need not be encoded faster
 
 
 def parse_address(text: str) -> tuple[str, int]:
@@ -213,6 +214,7 @@ class LiveView:
     def _stream(self, write: Callable[[bytes], None]) -> None:
         sh = self._shared
         sent = [0]  # the last frame sent to this viewer
+        last_write = -1.0
         with sh.cond:
             sh.viewers += 1
         try:
@@ -223,11 +225,15 @@ class LiveView:
                         return
                     if sh.seq <= sent[0]:
                         continue
+                due = last_write + 1.0 / MAX_FPS - time.monotonic()
+                if due > 0:  # then send the newest frame there is by then
+                    time.sleep(due)
                 frame = self._frame()
                 if frame is None:
                     continue
                 seq, data, capture_ms = frame
                 sent[0] = seq
+                last_write = time.monotonic()
                 head = (f"--{BOUNDARY}\r\nContent-Type: image/jpeg\r\nContent-Length: {len(data)}\r\n"
                         f"X-Capture-Ms: {capture_ms:.1f}\r\nX-Frame: {seq}\r\n\r\n")
                 write(head.encode("ascii") + data + b"\r\n")
