@@ -78,7 +78,7 @@ def render_all(spec: Spec) -> dict[str, bytes]:
         for template_path in sorted(root.rglob("*.j2")):
             rel = template_path.relative_to(root).as_posix()
             if template_path.name.startswith("_") and not template_path.name.startswith("__"):
-                continue  # a partial, included by another template of the folder (__init__.py.j2 is not one)
+                continue  # a partial (_name, not __init__), included by another template of the folder
             text = env.get_template(rel).render(context)
             out = rel[: -len(".j2")]
             for placeholder, value in names.items():
