@@ -85,19 +85,21 @@ def flight_rate(
     """One simulated flight; returns the loop rate and, with a browser watching, its frame latencies (ms)."""
     rate = Rate()
     observers: list[Observer] = [rate]
-    if paced:
-        observers.append(WallClockPacing())
     view = None
     if mode != "no --serve":
         view = LiveView("127.0.0.1", 0, StopSwitch())
         observers.append(view)
+    if paced:  # last, as in the command line: the view gets each tick before the pacing sleep
+        observers.append(WallClockPacing())
     latencies: list[float] = []
     try:
         if mode == "browser watching":
             assert view is not None
             browser.get(view.url)  # type: ignore[attr-defined]
             browser.execute_script("window.liveView.latencies.length = 0")  # type: ignore[attr-defined]
-        fly("ahead", 2, executable=executable, observers=observers, max_seconds=seconds)
+        flight = fly("ahead", 2, executable=executable, observers=observers, max_seconds=seconds)
+        if not flight.success or flight.error:  # a rate of a failed flight measures nothing
+            raise SystemExit(f"bench-tools: the flight failed ({mode}): {flight.summary()} {flight.error or ''}")
         if mode == "browser watching":
             latencies = list(browser.execute_script("return window.liveView.latencies"))  # type: ignore[attr-defined]
             browser.get("about:blank")  # type: ignore[attr-defined]
