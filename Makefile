@@ -10,10 +10,11 @@ VENV_STAMP := $(VENV)/.installed
 APT_STAMP := build/.apt-packages
 
 # Debian 12 packages: the AVR toolchain and Arduino core, arduino-builder (the IDE's builder) and avrdude,
-# simavr, host compilers, clang + libFuzzer, valgrind.
+# simavr, host compilers, clang + libFuzzer, valgrind, Chromium and its WebDriver (the browser tests).
 APT_PACKAGES := make gcc g++ python3 python3-venv python3-pip gcc-avr binutils-avr avr-libc arduino-core-avr \
                 arduino-builder avrdude \
-                simavr libsimavr-dev libelf-dev pkg-config clang libclang-rt-14-dev valgrind
+                simavr libsimavr-dev libelf-dev pkg-config clang libclang-rt-14-dev valgrind \
+                chromium chromium-driver
 
 .PHONY: all demo test deps generate check-generated lint typecheck pytest fuzz fuzz-smoke bench clean
 
@@ -34,10 +35,14 @@ $(APT_STAMP): Makefile  # a package added here is installed on the next run
 	fi
 	@mkdir -p $(dir $@) && touch $@
 
-$(VENV_STAMP): pyproject.toml
+# The codec (generated/python, its own distribution) first, then the project, which depends on it; both editable.
+$(VENV_STAMP): pyproject.toml setup.py generated/python/pyproject.toml
 	@test -x $(PY) || $(PYTHON_SYSTEM) -m venv $(VENV)
-	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e '.[dev]'
+	@echo "Installing the Python environment in $(VENV) (the codec, the project and its dev tools)"
+	@mkdir -p build
+	@# pip's and setuptools' chatter goes to a log, shown only when the install fails
+	@{ $(PY) -m pip install -q --upgrade pip && $(PY) -m pip install -q -e generated/python -e '.[dev]'; } \
+	  >build/pip-install.log 2>&1 || { cat build/pip-install.log; echo "pip install failed (log: build/pip-install.log)"; exit 1; }
 	@touch $@
 
 generate: $(VENV_STAMP)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from generator.model import Spec
+from .model import Spec
 
 # ArduCopter's flight-mode slots: a pulse up to each bound selects slot 1, 2, ... (FLTMODE1..FLTMODE6).
 MODE_SLOT_BOUNDS_US = (1230, 1360, 1490, 1620, 1749)

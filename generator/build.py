@@ -8,15 +8,15 @@ import json
 from pathlib import Path
 from typing import TypeVar
 
-from generator import __version__, hardware
-from generator.diff import Contract, contract, version_problem
-from generator.errors import SpecError, SpecInvalid
-from generator.model import INTEGRITY_MODES, Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
-from generator.names import identifier_problem, protocol_name_problem, safe_file_name
-from generator.reader import Reader, is_int, kind_name
-from generator.source import INVALID, Node, display_path, load, read
-from generator.status import read_status
-from generator.widths import overflows
+from . import __version__, hardware
+from .diff import Contract, contract, version_problem
+from .errors import SpecError, SpecInvalid
+from .model import INTEGRITY_MODES, Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
+from .names import identifier_problem, protocol_name_problem, safe_file_name
+from .reader import Reader, is_int, kind_name
+from .source import INVALID, Node, display_path, load, read
+from .status import read_status
+from .widths import overflows
 
 T = TypeVar("T")
 

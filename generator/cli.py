@@ -11,16 +11,17 @@ import json
 import sys
 from pathlib import Path
 
-from generator import __version__
-from generator.build import load_spec
-from generator.diff import Contract, contract, diff
-from generator.errors import SpecInvalid
-from generator.source import display_path
+from . import __version__
+from .build import load_spec
+from .diff import Contract, contract, diff
+from .errors import SpecInvalid
+from .source import display_path
 
 EXIT_STALE = 1
 EXIT_BREAKING = 1
 EXIT_INVALID = 2
 CONTRACT_FILE = "contract.json"
+# Relative to the current folder: the repository's layout. An installed generator run elsewhere needs --spec.
 DEFAULT_SPEC = Path("spec/drone.yaml")
 
 
@@ -30,18 +31,32 @@ def main(argv: list[str] | None = None) -> int:
         return diff_main(args[1:])
     parser = argparse.ArgumentParser(prog="python -m generator", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--spec", type=Path, default=DEFAULT_SPEC, help="the YAML spec (default: %(default)s)")
+    parser.add_argument("--spec", type=Path, help=f"the YAML spec (default: {DEFAULT_SPEC} in the current folder)")
     parser.add_argument("--out", type=Path, default=Path("generated"), help="output folder (default: %(default)s)")
     parser.add_argument("--check", action="store_true", help="write nothing; exit 1 listing stale or missing files")
-    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    parser.add_argument("--version", action="store_true", help="print the generator's version and the spec's "
+                        "fingerprint, then exit")
     opts = parser.parse_args(args)
+    if opts.spec is None:
+        if not DEFAULT_SPEC.is_file():
+            if opts.version:
+                print(f"{parser.prog} {__version__} (no spec: {DEFAULT_SPEC} is not in the current folder)")
+                return 0
+            print(f"{parser.prog}: error: no spec given and no {DEFAULT_SPEC} in the current folder: "
+                  "pass --spec FILE", file=sys.stderr)
+            return EXIT_INVALID
+        opts.spec = DEFAULT_SPEC
     shown = display_path(opts.spec)
     try:
         spec = load_spec(opts.spec, previous=_previous_contract(opts.out / CONTRACT_FILE))
     except SpecInvalid as exc:
         _report(shown, exc)
         return EXIT_INVALID
-    from generator.render import render_all, stale_files, write_atomically  # Jinja only for a valid spec
+    if opts.version:
+        print(f"{parser.prog} {__version__} (spec {shown}: {spec.name} {spec.version}, "
+              f"fingerprint {spec.short_fingerprint})")
+        return 0
+    from .render import render_all, stale_files, write_atomically  # Jinja only for a valid spec
 
     files = render_all(spec)
     if opts.check:

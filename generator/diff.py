@@ -12,7 +12,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from generator.model import Spec
+from .model import Spec
 
 Contract = dict[str, Any]
 

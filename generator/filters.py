@@ -8,8 +8,8 @@ import textwrap
 from collections.abc import Callable
 from typing import Any
 
-from generator.model import check_text
-from generator.names import pascal
+from .model import check_text
+from .names import pascal
 
 
 class Safe(str):

@@ -4,11 +4,11 @@ Called from one line of build.py; kept apart so that the ArduPilot-facing rules 
 
 from __future__ import annotations
 
-from generator.ardupilot import FS_THR_RANGE_US, STICKS, fs_thr_value, mode_slot
-from generator.errors import SpecError
-from generator.model import Channel, Project, WiredPin, Wiring
-from generator.reader import Reader, is_int
-from generator.source import Node
+from .ardupilot import FS_THR_RANGE_US, STICKS, fs_thr_value, mode_slot
+from .errors import SpecError
+from .model import Channel, Project, WiredPin, Wiring
+from .reader import Reader, is_int
+from .source import Node
 
 PIN_RANGE = (2, 19)  # digital pins of an Uno (A0-A5 are 14-19); 0 and 1 are the USB serial port
 MODE_OUTPUT = "mode"  # the RC output that carries the flight-mode pulses (spec section flight_modes)

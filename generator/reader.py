@@ -6,8 +6,8 @@ import difflib
 import re
 from typing import TypeVar
 
-from generator.errors import SpecError
-from generator.source import INVALID, Node
+from .errors import SpecError
+from .source import INVALID, Node
 
 T = TypeVar("T")
 

@@ -9,14 +9,14 @@ from pathlib import Path
 
 import jinja2
 
-from generator import ardupilot, filters
-from generator.build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
-from generator.diff import contract
-from generator.model import Spec
-from generator.names import pascal
-from generator.targets import TARGETS, Target, comment_style
-from generator.vectors import build_vectors
-from generator.widths import CTYPES
+from . import ardupilot, filters
+from .build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
+from .diff import contract
+from .model import Spec
+from .names import pascal
+from .targets import TARGETS, Target, comment_style
+from .vectors import build_vectors
+from .widths import CTYPES
 
 TEMPLATES = Path(__file__).parent / "templates"
 

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import yaml
 
-from generator.errors import Location, SpecError
+from .errors import Location, SpecError
 
 MAX_BYTES = 256 * 1024  # the shipped spec is about 11 kB
 MAX_DEPTH = 16  # the shipped spec nests 5 deep

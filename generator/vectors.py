@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import string
 
-from generator.model import Category, Direction, Spec, Vector, check_text
+from .model import Category, Direction, Spec, Vector, check_text
 
 
 def build_vectors(spec: Spec) -> tuple[Vector, ...]:

@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
-from generator.model import Spec
+from .model import Spec
 
 
 @dataclass(frozen=True)

@@ -15,9 +15,9 @@ import cv2
 import numpy as np
 from cv2.typing import MatLike
 
-from pilot.config import ArucoConfig, VisionConfig
-from pilot.detection import Candidate, Detection, frame_size, range_of
-from pilot.errors import ConfigError
+from .config import ArucoConfig, VisionConfig
+from .detection import Candidate, Detection, frame_size, range_of
+from .errors import ConfigError
 
 
 def aruco_dictionary(name: str) -> cv2.aruco.Dictionary:

@@ -20,10 +20,10 @@ import cv2
 import numpy as np
 from cv2.typing import MatLike
 
-from pilot import config as config_mod
-from pilot.config import HsvConfig, HsvRange, PilotConfig
-from pilot.errors import ConfigError
-from pilot.hsv import HsvBlobDetector
+from . import config as config_mod
+from .config import HsvConfig, HsvRange, PilotConfig
+from .errors import ConfigError
+from .hsv import HsvBlobDetector
 
 Roi = tuple[int, int, int, int]  # x, y, w, h
 MIN_SATURATION = 60  # greyish pixels say nothing about hue

@@ -15,7 +15,7 @@ from typing import Any, TypeVar
 import drone_protocol as dp
 import yaml
 
-from pilot.errors import ConfigError
+from .errors import ConfigError
 
 HsvTriple = tuple[int, int, int]
 HsvRange = tuple[HsvTriple, HsvTriple]

@@ -39,9 +39,9 @@ from dataclasses import dataclass
 
 import drone_protocol as dp
 
-from pilot.config import ControllerConfig
-from pilot.detection import Detection
-from pilot.gating import Gate
+from .config import ControllerConfig
+from .detection import Detection
+from .gating import Gate
 
 
 class State(enum.Enum):

@@ -15,13 +15,13 @@ from __future__ import annotations
 
 from cv2.typing import MatLike
 
-from pilot.aruco import ArucoMarkerDetector, aruco_dictionary
-from pilot.config import PilotConfig, VisionConfig
-from pilot.detection import CandidateSource, Detection, Detector, FrameStatus, range_of
-from pilot.errors import ConfigError
-from pilot.frames import FrameCheck
-from pilot.hsv import HsvBlobDetector
-from pilot.tracking import Tracker
+from .aruco import ArucoMarkerDetector, aruco_dictionary
+from .config import PilotConfig, VisionConfig
+from .detection import CandidateSource, Detection, Detector, FrameStatus, range_of
+from .errors import ConfigError
+from .frames import FrameCheck
+from .hsv import HsvBlobDetector
+from .tracking import Tracker
 
 __all__ = [
     "ArucoMarkerDetector", "Detection", "Detector", "FrameStatus", "HsvBlobDetector", "TrackedDetector",

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from pilot.detection import FrameStatus
+from .detection import FrameStatus
 
 MIN_WIDTH, MIN_HEIGHT = 32, 24
 BLACK_LEVEL = 12  # brightest channel at or below this: black

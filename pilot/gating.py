@@ -15,8 +15,8 @@ A bad frame (``FrameStatus`` other than OK) is never a sighting and breaks the c
 
 from __future__ import annotations
 
-from pilot.config import ControllerConfig
-from pilot.detection import Detection, FrameStatus
+from .config import ControllerConfig
+from .detection import Detection, FrameStatus
 
 
 class Gate:

@@ -24,9 +24,9 @@ import cv2
 import numpy as np
 from cv2.typing import MatLike
 
-from pilot.config import HsvConfig, VisionConfig
-from pilot.detection import Candidate, Detection, frame_size, range_of
-from pilot.errors import ConfigError
+from .config import HsvConfig, VisionConfig
+from .detection import Candidate, Detection, frame_size, range_of
+from .errors import ConfigError
 
 MAX_CANDIDATES = 6  # the largest blobs scored in full; smaller ones cannot be the nearest target
 # score ramps (zero, one), set on the tuning photos only (bench/vision/RESULTS.md)

@@ -24,8 +24,8 @@ from typing import Any, Self
 import drone_protocol as dp
 import serial
 
-from pilot.closing import Closing
-from pilot.errors import FingerprintMismatch, LinkError, ReadyTimeout
+from .closing import Closing
+from .errors import FingerprintMismatch, LinkError, ReadyTimeout
 
 MAX_LINE = 128
 

@@ -22,10 +22,15 @@ from typing import Protocol, TextIO
 
 import drone_protocol as dp
 
-from pilot.controller import Controller, State
-from pilot.detect import Detection, Detector
-from pilot.errors import FrameSourceError
-from pilot.sources import Frame, FrameSource
+from .controller import Controller, State
+from .detect import Detection, Detector
+from .errors import FrameSourceError
+from .sources import Frame, FrameSource
+
+
+class StopRequested(KeyboardInterrupt):
+    """A stop asked from another thread (the live view's Stop button), raised in the loop by an observer
+    (pilot.observers.StopSwitch): the same safe way out as Ctrl-C."""
 
 
 class Sink(Protocol):
@@ -123,6 +128,7 @@ class StatusLine:
         self._last = -math.inf
         self._state: State | None = None
         self._sends: deque[float] = deque()
+        self._t0: float | None = None  # the first tick: times are printed from the start of the run
 
     def on_tick(self, tick: Tick) -> None:
         if tick.command is not None:
@@ -136,9 +142,12 @@ class StatusLine:
         if not self.live and not changed:
             return
         self._last = tick.t
+        if self._t0 is None:
+            self._t0 = tick.t
         seen = "yes" if tick.detection is not None and tick.detection.found else "no "
         last = tick.command.decode("ascii") if tick.command else "      "
-        line = f"t {tick.t:7.2f}s  state {tick.state.value:8s}  target {seen}  {len(self._sends):3d} cmd/s  last {last}"
+        line = (f"t {tick.t - self._t0:7.2f}s  state {tick.state.value:8s}  target {seen}  "
+                f"{len(self._sends):3d} cmd/s  last {last}")
         self.out.write(f"\r{line}" if self.live else f"{line}\n")
         self.out.flush()
 
@@ -203,6 +212,8 @@ def run(
             pacer.wait_tick()
     except FrameSourceError as exc:
         reason, error = f"camera lost: {exc}", exc
+    except StopRequested as exc:
+        reason, error = f"stop requested ({exc})", exc
     except KeyboardInterrupt as exc:
         reason, error = "interrupted", exc
     except BaseException as exc:  # any stage: land safely first, report afterwards

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from pilot.config import VisionConfig
-from pilot.detection import Candidate
+from .config import VisionConfig
+from .detection import Candidate
 
 SIZE_RATIO = 1.6  # per frame; a target 1.6x nearer in 50 ms would be closing at tens of m/s
 BRIDGE_DECAY = 0.8  # confidence kept per bridged frame

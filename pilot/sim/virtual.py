@@ -17,9 +17,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
-from pilot.closing import Closing
-from pilot.errors import SimulatorError
-from pilot.sim.model import Outputs
+from ..closing import Closing
+from ..errors import SimulatorError
+from .model import Outputs
 
 REPO = Path(__file__).resolve().parents[2]
 DEFAULT_EXE = REPO / "firmware" / "build" / "host" / "virtual_drone"

@@ -155,7 +155,8 @@ def test_no_timestamps_or_absolute_paths_in_the_output() -> None:
 
 def test_version_and_the_installed_console_script(tmp_path: Path) -> None:
     run = h.generate("--version")
-    assert run.code == 0 and run.stdout.strip() == f"python -m generator {__version__}"
+    assert run.code == 0 and run.stdout.strip().startswith(f"python -m generator {__version__} (spec ")
+    assert load_spec(h.SPEC).short_fingerprint in run.stdout
     script = Path(sys.executable).parent / "drone-protocol-gen"
     assert script.exists(), "pyproject.toml's console script is not installed in the venv"
     proc = subprocess.run([str(script), "--spec", str(h.SPEC), "--out", str(tmp_path)], capture_output=True,
