@@ -14,6 +14,8 @@ from pathlib import Path
 from typing import Any
 
 import drone_protocol as dp
+from generator.build import load_spec
+from generator.model import Spec, check_text
 
 ROOT = Path(__file__).resolve().parents[2]
 BUILD = ROOT / "firmware" / "build"
@@ -51,6 +53,64 @@ def on_ground() -> dict[str, int]:
     return {**neutral(), "throttle": dp.CHANNELS["throttle"].minimum}
 
 
+# --- reply lines, from the spec's model ----------------------------------------------------------------------------
+
+
+class Replies:
+    """Reply lines as the spec defines them (prefixes, error codes, status codes, integrity check).
+
+    Built from the generator's model of a spec file, so the tests need nothing of the Python codec's reply API and
+    work for a copy of the spec (another integrity mode, new commands) as well."""
+
+    def __init__(self, spec: Spec) -> None:
+        self.spec = spec
+
+    def ready(self) -> str:
+        s = self.spec
+        return self._checked(f"{s.reply('ready').prefix} {s.name} {s.short_fingerprint} {s.integrity}")
+
+    def accepted(self, frame: bytes) -> str:
+        """The body of the accepted reply to `frame` (no status)."""
+        return self.spec.reply("accepted").prefix + frame[:2].decode("ascii")
+
+    def rejected(self, error: str) -> str:
+        return self.spec.reply("rejected").prefix + self.spec.error(error).code
+
+    def failsafe(self) -> str:
+        return self.spec.reply("failsafe").prefix
+
+    def line(self, body: str, state: str, laser: bool) -> str:
+        """A whole reply line (no newline): body, status of state `state` (a name) and the laser, check."""
+        st = self.spec.status
+        code = st.state(state).code
+        return self._checked(f"{body}{st.separator}{code}{st.laser_on if laser else st.laser_off}")
+
+    def parse(self, line: str) -> tuple[str, str | None, bool | None]:
+        """(body, state name, laser) of a reply line; the check is verified (crc8) and the status split off."""
+        if self.spec.integrity == "crc8":
+            text, star, check = line.rpartition("*")
+            assert star and check == check_text(text.encode("ascii")), f"bad reply check: {line!r}"
+            line = text
+        if line.startswith(self.spec.reply("ready").prefix):
+            return line, None, None
+        st = self.spec.status
+        body, sep, status = line[:-3], line[-3], line[-2:]
+        assert sep == st.separator and len(status) == 2, f"no status in {line!r}"
+        names = {s.code: s.name for s in st.states}
+        assert status[0] in names and status[1] in (st.laser_on, st.laser_off), f"bad status in {line!r}"
+        return body, names[status[0]], status[1] == st.laser_on
+
+    def body(self, line: str) -> str:
+        return self.parse(line)[0]
+
+    def _checked(self, text: str) -> str:
+        return text + ("*" + check_text(text.encode("ascii")) if self.spec.integrity == "crc8" else "")
+
+
+SPEC = load_spec(ROOT / "spec" / "drone.yaml")
+R = Replies(SPEC)
+
+
 # --- the virtual drone, driven with a stepped clock ------------------------------------------------------------
 
 
@@ -63,9 +123,13 @@ class Trace:
     stats: list[dict[str, Any]] = field(default_factory=list)
     end_ms: int = 0
 
-    def replies(self, since_ms: int = 0) -> list[str]:
+    def lines(self, since_ms: int = 0) -> list[str]:
         """Reply lines (without newline) sent at or after `since_ms`."""
         return [line for t, text in self.tx if t >= since_ms for line in text.splitlines()]
+
+    def replies(self, since_ms: int = 0, replies: Replies | None = None) -> list[str]:
+        """Reply bodies (no status, no check) sent at or after `since_ms`; the ready line whole."""
+        return [(replies or R).body(line) for line in self.lines(since_ms)]
 
     def state_at(self, t_ms: int) -> dict[str, Any]:
         """The outputs in force at time t_ms (the last change at or before it)."""
@@ -119,9 +183,9 @@ class Script:
             waited += period_ms
         return self.step(5)  # the last keep-alive is read and answered before the caller goes on
 
-    def run(self) -> Trace:
+    def run(self, binary: Path = VIRTUAL_DRONE) -> Trace:
         result = subprocess.run(
-            [str(VIRTUAL_DRONE), "--stdin", "--clock", "stepped"],
+            [str(binary), "--stdin", "--clock", "stepped"],
             input="\n".join(self.lines) + "\n",
             capture_output=True,
             text=True,
@@ -157,12 +221,20 @@ class SimResult:
         lo, hi = start_ms * 16000, end_ms * 16000
         return [w / CYCLES_PER_US for rise, w in self.pulses.get(pin, []) if lo <= rise < hi]
 
-    def replies(self) -> list[str]:
+    def lines(self) -> list[str]:
+        """Reply lines (without newline)."""
         return [line for _, text in self.tx for line in text.splitlines()]
 
-    def replies_between(self, start_ms: float, end_ms: float) -> list[str]:
+    def lines_between(self, start_ms: float, end_ms: float) -> list[str]:
         lo, hi = start_ms * 16000, end_ms * 16000
         return [line for t, text in self.tx if lo <= t < hi for line in text.splitlines()]
+
+    def replies(self, replies: Replies | None = None) -> list[str]:
+        """Reply bodies (no status, no check); the ready line whole."""
+        return [(replies or R).body(line) for line in self.lines()]
+
+    def replies_between(self, start_ms: float, end_ms: float, replies: Replies | None = None) -> list[str]:
+        return [(replies or R).body(line) for line in self.lines_between(start_ms, end_ms)]
 
     def laser_at(self, t_ms: float) -> int:
         level = 0
