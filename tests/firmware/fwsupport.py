@@ -8,12 +8,15 @@ from __future__ import annotations
 
 import json
 import subprocess
+import sys
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import drone_protocol as dp
+import yaml
+
 from generator.build import load_spec
 from generator.model import Spec, check_text
 
@@ -109,6 +112,55 @@ class Replies:
 
 SPEC = load_spec(ROOT / "spec" / "drone.yaml")
 R = Replies(SPEC)
+
+
+# --- firmware built from a copy of the spec ------------------------------------------------------------------------
+
+
+def spec_copy() -> dict[str, Any]:
+    """The shipped spec as data, to edit: tests never edit the live spec."""
+    data: dict[str, Any] = yaml.safe_load((ROOT / "spec" / "drone.yaml").read_text(encoding="utf-8"))
+    return data
+
+
+@dataclass(frozen=True)
+class Built:
+    """The AVR firmware and the virtual drone built from a regenerated copy of the spec."""
+
+    spec: Spec
+    library: Path
+    uno_elf: Path
+    virtual_drone: Path
+
+    @property
+    def replies(self) -> Replies:
+        return Replies(self.spec)
+
+    def wire(self, frame: bytes) -> bytes:
+        """A frame as it goes on the wire: with its check in crc8 mode."""
+        return frame + (check_text(frame).encode("ascii") if self.spec.integrity == "crc8" else b"")
+
+    def frame(self, command: str, value: int) -> bytes:
+        """The wire bytes of `command` (its name in this spec) with `value`."""
+        (cmd,) = [c for c in self.spec.commands if c.direction.command == command]
+        return self.wire(cmd.direction.frame(cmd.category.code, value).encode("ascii"))
+
+
+def build_from_spec(data: dict[str, Any], tmp: Path) -> Built:
+    """Write `data` as a spec in `tmp`, regenerate into `tmp/generated` and build the Uno firmware and the virtual
+    drone against it (`make` with DRONE_PROTOCOL_DIR and FW_BUILD; the Arduino cores are shared)."""
+    spec_path = tmp / "drone.yaml"
+    spec_path.write_text(yaml.safe_dump(data, sort_keys=False, allow_unicode=True), encoding="utf-8")
+    out = tmp / "generated"
+    result = subprocess.run([sys.executable, "-m", "generator", "--spec", str(spec_path), "--out", str(out)],
+                            cwd=ROOT, capture_output=True, text=True, check=False)
+    assert result.returncode == 0, result.stderr
+    library = out / "arduino" / "DroneProtocol"
+    build = tmp / "build"
+    make("firmware-sim")
+    elf, host = build / "uno" / "uno.elf", build / "host" / "virtual_drone"
+    make(str(elf), str(host), DRONE_PROTOCOL_DIR=str(library), FW_BUILD=str(build), FW_CORE_BUILD=str(BUILD))
+    return Built(load_spec(spec_path), library, elf, host)
 
 
 # --- the virtual drone, driven with a stepped clock ------------------------------------------------------------

@@ -90,8 +90,8 @@ def test_disarm_in_the_air_is_refused_and_changes_nothing() -> None:
     t0 = script.t_ms
     script.send(dp.disarm()).step(5).send(dp.move_up()).step(5).send(dp.disarm()).step(5)
     trace = script.run()
-    assert trace.lines(since_ms=t0) == [refused("airborne", "hold_altitude", False), line(dp.move_up(), "moving", False),
-                                        refused("airborne", "moving", False)]
+    assert trace.lines(since_ms=t0) == [refused("airborne", "hold_altitude", False),
+                                        line(dp.move_up(), "moving", False), refused("airborne", "moving", False)]
     assert all(c["state"] != "disarming" for c in trace.changes)
 
 

@@ -142,13 +142,13 @@ def test_both_ends_write_and_read_the_same_reply_lines() -> None:
     assert (ready.kind, ready.protocol, ready.fingerprint) == (p.ReplyKind.READY, p.PROTOCOL_NAME, p.SPEC_FINGERPRINT)
     assert ready.integrity == p.INTEGRITY
     rest = iter(lines[1:])
-    for (cmd, state, laser), line in zip(accepted, rest):
+    for (cmd, state, laser), line in zip(accepted, rest, strict=False):
         reply = p.parse_reply(line)
         assert (reply.kind, reply.category, reply.direction, reply.state, reply.laser) == (
             p.ReplyKind.ACCEPTED, cmd.category, cmd.direction.value, state, laser)
-    for (kind, state, laser), line in zip(rejected, rest):
+    for (kind, state, laser), line in zip(rejected, rest, strict=False):
         reply = p.parse_reply(line)
         assert (reply.error, reply.state, reply.laser) == (kind, state, laser)
-    for (state, laser), line in zip(failsafe, rest):
+    for (state, laser), line in zip(failsafe, rest, strict=False):
         reply = p.parse_reply(line)
         assert (reply.kind, reply.state, reply.laser) == (p.ReplyKind.FAILSAFE, state, laser)
