@@ -24,11 +24,13 @@ DRONE_PROTOCOL_ALWAYS_INLINE Error step(Command& at, uint8_t pos, uint8_t byte) 
     CommandIndex index;
     if (!find_direction(static_cast<uint8_t>(at.id), byte, index)) return Error::BadDirection;
     at.id = static_cast<CommandId>(index);
+    at.direction = byte;
     at.value = 0;
   } else {
     const uint8_t slot = category_slot(byte);
     if (slot == 0) return Error::BadCategory;
     at.id = static_cast<CommandId>(slot - 1);
+    at.category = byte;
   }
   return Error::None;
 }
@@ -50,8 +52,6 @@ inline Error decode(const uint8_t* frame, size_t length, Command& out) {
     if (error != Error::None) return error;
   }
   if (!detail::in_range(at)) return Error::OutOfRange;
-  at.category = frame[0];
-  at.direction = frame[1];
   out = at;
   return Error::None;
 }
@@ -76,30 +76,57 @@ inline Error encode(const Command& command, uint8_t out[WIRE_LENGTH]) {
   return encode(command.id, command.value, out);
 }
 
-// Finds frames in a byte stream. Every byte is checked as it arrives (the digits are accumulated, the command
-// looked up once); on an invalid byte the parser slides forward one byte at a time, so a valid frame that
-// follows garbage is never lost; a partial frame older than INTER_BYTE_TIMEOUT_MS is dropped before the new
-// byte is considered. Each feed() costs at most WIRE_LENGTH slides of WIRE_LENGTH checks: it never stalls.
+// Finds frames in a byte stream. Every byte is checked as it arrives (the command looked up once at byte 1,
+// the digits accumulated); on an invalid byte the parser slides forward one byte at a time, so a valid frame
+// that follows garbage is never lost; a partial frame older than INTER_BYTE_TIMEOUT_MS is dropped before the
+// new byte is considered. Each feed() costs at most WIRE_LENGTH slides of WIRE_LENGTH checks: it never stalls.
+// The bytes of a partial frame are not kept: its command, value say what they were, and a slide (rare)
+// rebuilds them.
 class StreamParser {
  public:
   // constexpr: a global parser is zero-initialised in .bss, with no constructor code at start-up.
-  constexpr StreamParser() : buffer_{}, length_(0), last_error_(Error::None), last_ms_(0), command_{}, counts_{} {}
+  constexpr StreamParser() : length_(0), last_error_(Error::None), last_ms_(0), command_{}, counts_{} {}
 
   // Returns true when `byte` completes a valid frame; then command() holds it until the next feed().
   // Inlined: a byte of a clean stream costs one check of the new byte.
   DRONE_PROTOCOL_ALWAYS_INLINE bool feed(uint8_t byte, uint32_t now_ms) {
     last_error_ = Error::None;
     uint8_t n = length_;
-    if (n != 0 && static_cast<uint32_t>(now_ms - last_ms_) > INTER_BYTE_TIMEOUT_MS) n = drop_stale();
-    last_ms_ = now_ms;
-    const Error error = detail::step(command_, n, byte);
-    buffer_[n] = byte;
-    if (error != Error::None) return slide(static_cast<uint8_t>(n + 1), error);
-    if (++n < WIRE_LENGTH) {
-      length_ = n;
+    // The gap since the last byte, in 16 bits: exact below 65.536 s and cheaper than 32 on the AVR (a 32-bit
+    // clock wraps too, after 49.7 days); a longer silence has long set off the drone's failsafe.
+    const uint16_t now16 = static_cast<uint16_t>(now_ms);
+    if (n != 0 && static_cast<uint16_t>(now16 - last_ms_) > INTER_BYTE_TIMEOUT_MS) n = drop_stale();
+    last_ms_ = now16;
+    // The fast paths: a valid byte at its position (the checks of detail::step(), which the slow path uses),
+    // each a few instructions; anything else goes to reject().
+    if (n >= 2) {
+      const uint8_t digit = static_cast<uint8_t>(byte - '0');
+      if (digit > 9) return reject(n, byte);
+      command_.value = static_cast<uint16_t>(command_.value * 10u + digit);
+      if (++n < WIRE_LENGTH) {
+        length_ = n;
+        return false;
+      }
+      return complete();
+    }
+    if (n == 1) {
+      CommandIndex index;
+      if (!detail::find_direction(static_cast<uint8_t>(command_.id), byte, index)) return reject(1, byte);
+      command_.id = static_cast<CommandId>(index);
+      command_.direction = byte;
+      command_.value = 0;
+      length_ = 2;
       return false;
     }
-    return complete();
+    const uint8_t slot = detail::category_slot(byte);
+    if (slot == 0) {
+      count(Error::BadCategory);  // garbage between frames: nothing pending, nothing to slide
+      return false;
+    }
+    command_.id = static_cast<CommandId>(slot - 1);
+    command_.category = byte;
+    length_ = 1;
+    return false;
   }
 
   const Command& command() const { return command_; }
@@ -122,24 +149,49 @@ class StreamParser {
   static constexpr uint8_t COUNTERS = STREAM_ERROR_COUNT + 0;
 
   // The last byte of a frame arrived: the range check, then the command is complete.
-  DRONE_PROTOCOL_NOINLINE bool complete() {
-    if (!detail::in_range(command_)) return slide(WIRE_LENGTH, Error::OutOfRange);
-    command_.category = buffer_[0];
-    command_.direction = buffer_[1];
+  DRONE_PROTOCOL_ALWAYS_INLINE bool complete() {
+    if (!detail::in_range(command_)) return out_of_range();
     length_ = 0;
     return true;
   }
 
-  // The first `length` buffered bytes end in one that caused `error`: count it, drop the oldest byte and
-  // re-check the rest from the start, until they form a valid prefix again (possibly empty). A slide never
-  // completes a frame: it leaves fewer than WIRE_LENGTH bytes.
-  DRONE_PROTOCOL_NOINLINE bool slide(uint8_t length, Error error) {
+  // The first `n` bytes of the partial frame, rebuilt from what they established (they were all valid).
+  void rebuild(uint8_t n, uint8_t* out) const {
+    if (n > 0) out[0] = command_.category;
+    if (n > 1) out[1] = command_.direction;
+    uint16_t value = command_.value;
+    for (uint8_t i = n < FRAME_LENGTH ? n : FRAME_LENGTH; i-- > 2;) {
+      out[i] = static_cast<uint8_t>('0' + value % 10u);
+      value = static_cast<uint16_t>(value / 10u);
+    }
+  }
+
+  // `byte` is not valid at position `n`: which error it is (detail::step says), then the slide.
+  DRONE_PROTOCOL_NOINLINE bool reject(uint8_t n, uint8_t byte) {
+    uint8_t bytes[WIRE_LENGTH];
+    rebuild(n, bytes);
+    bytes[n] = byte;
+    return slide(bytes, static_cast<uint8_t>(n + 1), detail::step(command_, n, byte));
+  }
+
+  DRONE_PROTOCOL_NOINLINE bool out_of_range() {
+    uint8_t bytes[WIRE_LENGTH];
+    rebuild(WIRE_LENGTH, bytes);
+    return slide(bytes, WIRE_LENGTH, Error::OutOfRange);
+  }
+
+  // The `length` bytes end in one that caused `error`: count it, drop the oldest byte and re-check the rest
+  // from the start, until they form a valid prefix again (possibly empty). A slide never completes a frame: it
+  // leaves fewer than WIRE_LENGTH bytes.
+  bool slide(uint8_t* bytes, uint8_t length, Error error) {
     for (;;) {
       count(error);
       --length;
-      for (uint8_t i = 0; i < length; ++i) buffer_[i] = buffer_[i + 1];
+      for (uint8_t i = 0; i < length; ++i) bytes[i] = bytes[i + 1];
       error = Error::None;
-      for (uint8_t pos = 0; pos < length && error == Error::None; ++pos) error = detail::step(command_, pos, buffer_[pos]);
+      for (uint8_t pos = 0; pos < length && error == Error::None; ++pos) {
+        error = detail::step(command_, pos, bytes[pos]);
+      }
       if (error == Error::None) {
         length_ = length;
         return false;
@@ -164,11 +216,11 @@ class StreamParser {
     if (n != 0xFFFF) ++n;  // saturate rather than wrap
   }
 
-  uint8_t buffer_[WIRE_LENGTH];
   uint8_t length_;
   Error last_error_;
-  uint32_t last_ms_;
-  // The command being read (see detail::step), and the last one complete once feed() returned true.
+  uint16_t last_ms_;  // the low 16 bits of the clock at the last byte
+  // The frame being read (see detail::step: `id` is the category index after byte 0), and the last one complete
+  // once feed() returned true.
   Command command_;
   uint16_t counts_[COUNTERS];
 };
