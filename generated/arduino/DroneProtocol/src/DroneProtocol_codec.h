@@ -15,7 +15,8 @@ namespace detail {
 // returns the error the byte causes. `at` is the command being read: `id` holds the category index after
 // byte 0 and the command from byte 1 on, `value` the digits so far. Every byte is checked as it arrives: a category, a direction of that
 // category, ASCII digits.
-DRONE_PROTOCOL_ALWAYS_INLINE Error step(Command& at, uint8_t pos, uint8_t byte) {
+// Out of line: the parser's fast paths repeat its checks inline; it serves decode() and the slide.
+DRONE_PROTOCOL_NOINLINE inline Error step(Command& at, uint8_t pos, uint8_t byte) {
   if (pos >= 2) {
     const uint8_t digit = static_cast<uint8_t>(byte - '0');
     if (digit > 9) return Error::BadDigit;
@@ -150,7 +151,7 @@ class StreamParser {
 
   // The last byte of a frame arrived: the range check, then the command is complete.
   DRONE_PROTOCOL_ALWAYS_INLINE bool complete() {
-    if (!detail::in_range(command_)) return out_of_range();
+    if (!detail::in_range(command_)) return reject(WIRE_LENGTH, 0);
     length_ = 0;
     return true;
   }
@@ -166,18 +167,14 @@ class StreamParser {
     }
   }
 
-  // `byte` is not valid at position `n`: which error it is (detail::step says), then the slide.
+  // `byte` is not valid at position `n` (or, with n == WIRE_LENGTH, the complete frame is out of range): the
+  // error, then the slide over the rebuilt bytes.
   DRONE_PROTOCOL_NOINLINE bool reject(uint8_t n, uint8_t byte) {
     uint8_t bytes[WIRE_LENGTH];
     rebuild(n, bytes);
+    if (n == WIRE_LENGTH) return slide(bytes, WIRE_LENGTH, Error::OutOfRange);
     bytes[n] = byte;
     return slide(bytes, static_cast<uint8_t>(n + 1), detail::step(command_, n, byte));
-  }
-
-  DRONE_PROTOCOL_NOINLINE bool out_of_range() {
-    uint8_t bytes[WIRE_LENGTH];
-    rebuild(WIRE_LENGTH, bytes);
-    return slide(bytes, WIRE_LENGTH, Error::OutOfRange);
   }
 
   // The `length` bytes end in one that caused `error`: count it, drop the oldest byte and re-check the rest
