@@ -7,6 +7,7 @@ from a constant typed here.
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from collections.abc import Iterable
@@ -115,6 +116,11 @@ R = Replies(SPEC)
 
 
 # --- firmware built from a copy of the spec ------------------------------------------------------------------------
+
+
+def python_env() -> dict[str, str]:
+    """The environment for `python -m generator` run from the repository root."""
+    return {**os.environ, "PYTHONPATH": str(ROOT)}
 
 
 def spec_copy() -> dict[str, Any]:
