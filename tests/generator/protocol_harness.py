@@ -27,6 +27,12 @@ BUILD = ROOT / "build" / "tests" / "generator"
 CXXFLAGS = ("-std=c++11", "-Wall", "-Wextra", "-Werror", "-O1")
 
 
+def header_text(include: Path | None = None) -> str:
+    """The generated C++ library: DroneProtocol.h and the parts it includes, as one text."""
+    folder = include or HEADER.parent
+    return "\n".join(p.read_text(encoding="utf-8") for p in sorted(folder.glob("*.h")))
+
+
 def spec_text() -> str:
     return SPEC.read_text(encoding="utf-8")
 
