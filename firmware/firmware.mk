@@ -23,7 +23,7 @@ AVR_SIZE ?= avr-size
 HOST_CXX ?= g++
 HOST_CC ?= gcc
 
-FW_SKETCH_SRC := $(FW_DIR)/drone/drone_app.cpp $(FW_DIR)/drone/drone_logic.cpp \
+FW_SKETCH_SRC := $(FW_DIR)/drone/drone_app.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_DIR)/drone/drone_handlers.cpp \
                  $(FW_DIR)/drone/pulse_schedule.cpp $(FW_DIR)/drone/pulse_out_avr.cpp
 FW_HEADERS := $(wildcard $(FW_DIR)/drone/*.h)
 FW_PROTO_SRC = $(wildcard $(DRONE_PROTOCOL_DIR)/src/*.cpp)
@@ -117,7 +117,8 @@ firmware-uno: $(FW_BUILD)/uno/uno.hex
 # --- host build ---------------------------------------------------------------
 FW_HOST_DIR := $(FW_BUILD)/host
 FW_HOST_FLAGS := -std=c++11 -O1 -g -fsanitize=address,undefined -fno-sanitize-recover=all $(FW_WARN) -I$(FW_DIR)/host -I$(FW_DIR)/drone -I$(DRONE_PROTOCOL_DIR)/src
-FW_HOST_LOGIC := $(FW_DIR)/drone/drone_app.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_DIR)/drone/pulse_schedule.cpp \
+FW_HOST_LOGIC := $(FW_DIR)/drone/drone_app.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_DIR)/drone/drone_handlers.cpp \
+                 $(FW_DIR)/drone/pulse_schedule.cpp \
                  $(FW_DIR)/host/pulse_out_host.cpp $(FW_DIR)/host/fake_arduino.cpp
 FW_HOST_DEPS = $(FW_HEADERS) $(wildcard $(FW_DIR)/host/*.h) $(FW_PROTO_SRC) $(FW_PROTO_HDR)
 
@@ -132,7 +133,8 @@ $(FW_HOST_DIR)/pulse_schedule_test: $(FW_DIR)/host/pulse_schedule_test.cpp $(FW_
 	@$(HOST_CXX) $(FW_HOST_FLAGS) $(filter %.cpp,$^) -o $@
 
 # libFuzzer target over the whole logic (clang, from the toolchain stamp).
-$(FW_HOST_DIR)/fuzz_drone: $(FW_DIR)/host/fuzz_drone.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_HEADERS) $(FW_PROTO_HDR)
+$(FW_HOST_DIR)/fuzz_drone: $(FW_DIR)/host/fuzz_drone.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_DIR)/drone/drone_handlers.cpp \
+                           $(FW_HEADERS) $(FW_PROTO_HDR)
 	@mkdir -p $(@D)
 	@echo "  CXX   $@"
 	@clang++ -std=c++11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all $(FW_WARN) \

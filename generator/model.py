@@ -246,6 +246,14 @@ class Spec:
     def category_lookup(self) -> ByteLookup:
         return _lookup({ord(c.code): i for i, c in enumerate(self.categories)})
 
+    # --- C++ parser tables (firmware helper) ---
+    @property
+    def direction_lookups(self) -> tuple[ByteLookup, ...]:
+        """Per category: its direction bytes to the index within the category + 1 (0: none), for the C++
+        parser's constant-time byte-1 lookup."""
+        return tuple(_lookup({ord(d.code): i for i, d in enumerate(c.directions)}) for c in self.categories)
+    # --- end of C++ parser tables ---
+
     @property
     def category_ranges(self) -> tuple[tuple[int, int], ...]:
         """(index of the first command, number of commands) of each category, in order."""

@@ -55,7 +55,8 @@ CTYPES: Mapping[str, CType] = MappingProxyType({
     "channel": UINT16,  # <CHANNEL>_MIN/_MAX/_MEDIAN/_LOW/_HIGH, ChannelLimits
     "servo": UINT8,  # SERVO_<NAME>_MIN/_MAX/_DEFAULT
     "value": UINT16,  # a command's value, minimum, maximum and default (Command, CommandInfo)
-    "command_index": INT8,  # CommandId, find_command(), CategoryRange: indexes 0..COMMAND_COUNT - 1
+    # CommandId: uint8_t up to 254 commands, uint16_t beyond (the template picks); 94 x 94 codes fit either way
+    "command_index": UINT16,
     "count": UINT8,  # CATEGORY_COUNT, CHANNEL_COUNT and the Target and Error enums (with their None)
 })
 

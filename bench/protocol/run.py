@@ -240,8 +240,10 @@ def bench_python(settings: Settings) -> list[Row]:
     # What the Arduino answers to that mix: mostly acceptances, some refusals and the odd failsafe.
     reply_rng = random.Random(4)
     errors = list(dp.ErrorKind)
-    replies = [dp.accepted_line(dp.decode(f)) if reply_rng.random() < 0.9 else
-               (dp.rejected_line(reply_rng.choice(errors)) if reply_rng.random() < 0.95 else dp.failsafe_line())
+    moving, failsafe = dp.DroneState.MOVING, dp.DroneState.FAILSAFE
+    replies = [dp.accepted_line(dp.decode(f), moving, False) if reply_rng.random() < 0.9 else
+               (dp.rejected_line(reply_rng.choice(errors), moving, False) if reply_rng.random() < 0.95
+                else dp.failsafe_line(failsafe, False))
                for f in frames]
 
     # The subjects must produce what the floors produce before they are timed.

@@ -34,18 +34,17 @@ def sticks(change: dict[str, Any]) -> dict[str, int]:
 
 
 def accepted(frame: bytes) -> str:
-    return dp.accepted_line(dp.decode(frame)).decode().rstrip("\n")
+    return fw.R.accepted(frame)
 
 
 def rejected(kind: dp.ErrorKind) -> str:
-    return dp.rejected_line(kind).decode().rstrip("\n")
+    return fw.R.rejected(kind.name.lower())
 
 
 def test_boot_prints_ready_with_the_spec_fingerprint_and_outputs_are_safe() -> None:
     trace = fw.Script().step(5).run()
-    ready = dp.parse_reply((trace.replies()[0] + "\n").encode())
-    assert ready.kind == dp.ReplyKind.READY
-    assert ready.fingerprint == dp.SPEC_FINGERPRINT
+    assert trace.lines()[0] == fw.R.ready()
+    assert trace.lines()[0].split()[2] == dp.SPEC_FINGERPRINT
     boot = trace.changes[0]
     assert boot["t_ms"] == 0
     assert sticks(boot) == fw.on_ground()
@@ -83,7 +82,7 @@ def test_arming_holds_throttle_low_and_yaw_right_for_the_arming_time() -> None:
 
 
 def test_disarming_holds_throttle_low_and_yaw_left_then_disarms() -> None:
-    script = fw.Script().arm().send(dp.hold_altitude()).step(10)
+    script = fw.Script().arm().step(10)  # on the ground: ik0000 is honoured (in the air it is refused)
     t0 = script.t_ms
     script.send(dp.disarm())
     for _ in range(12):
@@ -206,8 +205,8 @@ def test_failsafe_after_silence_sets_failsafe_throttle_neutral_sticks_laser_off_
     assert {k: fs[k] for k in ("roll", "pitch", "yaw")} == {k: fw.neutral()[k] for k in ("roll", "pitch", "yaw")}
     assert fs["laser"] is False
     assert fs["mode"] == dp.MODE_ALT_HOLD_US  # the mode channel stays as it was
-    assert (fw.Trace(tx=[(t, x) for t, x in trace.tx if t == fs["t_ms"]]).replies()) == [
-        dp.failsafe_line().decode().rstrip("\n")
+    assert (fw.Trace(tx=[(t, x) for t, x in trace.tx if t == fs["t_ms"]]).lines()) == [
+        fw.R.line(fw.R.failsafe(), "failsafe", False)
     ]
     assert trace.changes[-1] == fs  # and it stays there
 
@@ -238,14 +237,17 @@ def test_refused_frames_still_prove_the_link_and_failsafe_recovers_on_a_valid_fr
     assert recovered["t_ms"] == dp.FAILSAFE_TIMEOUT_MS + 11
 
 
-def test_armed_drone_leaving_failsafe_keeps_throttle_low_until_commanded() -> None:
+def test_an_armed_drone_leaving_failsafe_is_disarmed_and_must_arm_again() -> None:
     script = fw.Script().arm()
     script.step(dp.FAILSAFE_TIMEOUT_MS + 10)
     t0 = script.t_ms
-    trace = script.send(dp.servo_reset()).step(5).run()
+    trace = script.send(dp.servo_reset()).step(5).send(dp.move_forward()).step(5).run()
+    assert trace.state_at(t0 - 1)["state"] == "failsafe" and trace.state_at(t0 - 1)["armed"] is False
     after = trace.state_at(t0 + 1)
-    assert after["state"] == "armed" and after["armed"] is True
+    assert after["state"] == "disarmed" and after["armed"] is False
     assert sticks(after) == fw.on_ground()
+    assert trace.lines(since_ms=t0) == [fw.R.line(accepted(dp.servo_reset()), "disarmed", False),
+                                        fw.R.line(rejected(dp.ErrorKind.NOT_ARMED), "disarmed", False)]
 
 
 def test_a_frame_split_by_a_long_pause_is_dropped() -> None:
@@ -298,7 +300,9 @@ def test_movement_during_a_sequence_is_busy_but_disarm_always_wins() -> None:
     t_disarm = script.t_ms
     trace = script.send(dp.disarm()).step(5).run()
     assert trace.replies(since_ms=7) == [rejected(dp.ErrorKind.BUSY)] * 3 + [accepted(dp.disarm())]
-    assert trace.first_change(since_ms=t_disarm, state="disarming")["armed"] is False
+    start = trace.first_change(since_ms=t_disarm, state="disarming")  # the arming sequence is aborted
+    yaw, throttle = dp.CHANNELS[dp.ChannelName.YAW], dp.CHANNELS[dp.ChannelName.THROTTLE]
+    assert start["yaw"] == yaw.minimum and start["throttle"] == throttle.minimum
     assert all(c["pitch"] == fw.neutral()["pitch"] for c in trace.changes)
 
 
@@ -341,7 +345,7 @@ def test_self_test_is_refused_when_armed() -> None:
     script = fw.Script().arm()
     t0 = script.t_ms
     trace = script.send(dp.first_test()).step(10).run()
-    assert trace.replies(since_ms=t0) == [rejected(dp.ErrorKind.BUSY)]
+    assert trace.lines(since_ms=t0) == [fw.R.line(rejected(dp.ErrorKind.ARMED), "armed", False)]
     assert [c for c in trace.changes if c["t_ms"] >= t0] == []
 
 
@@ -438,14 +442,16 @@ def test_virtual_drone_over_a_pty_with_the_stepped_clock() -> None:
             assert lines[-1] == {"tick": 15}
             (change,) = lines[:-1]
             assert change["laser"] is True and change["t_ms"] == 6
-            assert read_until(fd, b"Al0\n") == dp.ready_line() + b"Al0\n"
+            toggled = fw.R.line(fw.R.accepted(dp.laser_toggle()), "disarmed", True)
+            ready = fw.R.ready().encode() + b"\n"
+            assert read_until(fd, toggled.encode() + b"\n") == ready + toggled.encode() + b"\n"
         finally:
             os.close(fd)
         fd = os.open(pty, os.O_RDWR | os.O_NOCTTY)  # reopening resets the board
         try:
             lines = step(10)
             assert [c["laser"] for c in lines[:-1]] == [False]
-            assert read_until(fd, b"\n") == dp.ready_line()
+            assert read_until(fd, b"\n") == ready
         finally:
             os.close(fd)
     finally:

@@ -20,6 +20,7 @@ def test_outputs_are_clamped_to_the_recorded_extremes_even_past_the_parser(tmp_p
             f"-I{fw.ROOT / 'generated' / 'arduino' / 'DroneProtocol' / 'src'}",
             str(Path(__file__).with_name("logic_probe.cpp")),
             str(fw.ROOT / "firmware" / "drone" / "drone_logic.cpp"),
+            str(fw.ROOT / "firmware" / "drone" / "drone_handlers.cpp"),
             "-o", str(exe),
         ],
         check=True,

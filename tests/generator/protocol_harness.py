@@ -33,6 +33,12 @@ BUILD = ROOT / "build" / "tests" / "generator"
 CXXFLAGS = ("-std=c++11", "-Wall", "-Wextra", "-Werror", "-O1")
 
 
+def header_text(include: Path | None = None) -> str:
+    """The generated C++ library: DroneProtocol.h and the parts it includes, as one text."""
+    folder = include or HEADER.parent
+    return "\n".join(p.read_text(encoding="utf-8") for p in sorted(folder.glob("*.h")))
+
+
 def spec_text() -> str:
     """The text of the frozen fixture spec (never the live one)."""
     return FIXTURE.read_text(encoding="utf-8")
@@ -110,8 +116,8 @@ def compile_cpp(source: Path | str, name: str, include: Path | None = None,
     Executables are cached in build/tests/generator/ by a hash of source, header and flags."""
     include = include or HEADER.parent
     text = source.read_text(encoding="utf-8") if isinstance(source, Path) else source
-    key = hashlib.sha256("\0".join([text, (include / "DroneProtocol.h").read_text(encoding="utf-8"), compiler,
-                                    *flags]).encode()).hexdigest()[:16]
+    headers = [h.read_text(encoding="utf-8") for h in sorted(include.glob("*.h"))]  # the header and its parts
+    key = hashlib.sha256("\0".join([text, *headers, compiler, *flags]).encode()).hexdigest()[:16]
     BUILD.mkdir(parents=True, exist_ok=True)
     exe = BUILD / f"{name}-{key}"
     if exe.exists():

@@ -74,7 +74,7 @@ def test_the_parameter_file_matches_the_spec() -> None:
         spec_field(spec, comment)  # every comment names a field of the spec (KeyError otherwise)
     fs_value = params.pop("FS_THR_VALUE")[0]
     assert {name: value for name, (value, _) in params.items()} == expected(spec)
-    assert spec["safety"]["failsafe_throttle_us"] < fs_value < dp.CHANNELS["throttle"].minimum
+    assert spec["safety"]["failsafe_throttle_us"] < fs_value < dp.CHANNELS[dp.ChannelName.THROTTLE].minimum
     assert FS_THR_VALUE_RANGE[0] <= fs_value <= FS_THR_VALUE_RANGE[1]
 
 
@@ -96,7 +96,7 @@ def generate(tmp_path: Path, *edits: tuple[str, str]) -> tuple[h.Run, str, Path]
 
 
 def test_the_smallest_failsafe_gap_gives_the_value_in_it(tmp_path: Path) -> None:
-    minimum = dp.CHANNELS["throttle"].minimum
+    minimum = dp.CHANNELS[dp.ChannelName.THROTTLE].minimum
     run, _, _ = generate(tmp_path, ("failsafe_throttle_us: 950", f"failsafe_throttle_us: {minimum - 2}"))
     assert run.code == 0, run.stderr
     params = strict_parse((tmp_path / "out" / "ardupilot" / "drone.parm").read_text(encoding="utf-8"))
@@ -106,7 +106,7 @@ def test_the_smallest_failsafe_gap_gives_the_value_in_it(tmp_path: Path) -> None
 @pytest.mark.parametrize("failsafe", [0, 1, 100])  # offsets from the throttle minimum - 1
 def test_a_spec_without_a_failsafe_gap_is_rejected_where_the_failsafe_throttle_is(tmp_path: Path,
                                                                                   failsafe: int) -> None:
-    value = dp.CHANNELS["throttle"].minimum - 1 + failsafe
+    value = dp.CHANNELS[dp.ChannelName.THROTTLE].minimum - 1 + failsafe
     run, text, spec = generate(tmp_path, ("failsafe_throttle_us: 950", f"failsafe_throttle_us: {value}"))
     assert run.code == 2
     where = h.location(text, f"failsafe_throttle_us: {value}")

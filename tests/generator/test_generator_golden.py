@@ -75,8 +75,10 @@ def test_check_names_a_missing_file(tmp_path: Path) -> None:
 def test_check_fails_on_a_hand_edit_of_a_generated_file(tmp_path: Path) -> None:
     out = tmp_path / "generated"
     shutil.copytree(h.fixture_generated(), out)
-    header = out / "arduino" / "DroneProtocol" / "src" / "DroneProtocol.h"
-    header.write_bytes(header.read_bytes().replace(b"INTER_BYTE_TIMEOUT_MS = 20;", b"INTER_BYTE_TIMEOUT_MS = 50;"))
+    header = out / "arduino" / "DroneProtocol" / "src" / "DroneProtocol_spec.h"
+    edited = header.read_bytes().replace(b"INTER_BYTE_TIMEOUT_MS = 20;", b"INTER_BYTE_TIMEOUT_MS = 50;")
+    assert edited != header.read_bytes()
+    header.write_bytes(edited)
     run = h.generate("--spec", h.FIXTURE, "--out", out, "--check")
     assert (run.code, run.stdout.splitlines()) == (1, [f"stale: {header}"])
 
@@ -129,11 +131,11 @@ def test_every_generated_file_carries_the_do_not_edit_header_with_the_fingerprin
 def test_both_ends_export_the_same_fingerprint() -> None:
     spec = load_spec(h.SPEC)
     python = (h.GENERATED / "python" / "drone_protocol" / "tables.py").read_text()
-    header = h.HEADER.read_text()
+    header = h.header_text()
     assert f'SPEC_FINGERPRINT: Final = "{spec.short_fingerprint}"' in python
     assert f'SPEC_SHA256: Final = "{spec.fingerprint}"' in python
     assert f'constexpr char SPEC_FINGERPRINT[] = "{spec.short_fingerprint}";' in header
-    assert f"{spec.reply('ready').prefix} {spec.name} {spec.short_fingerprint}\\n" in header
+    assert f'"{spec.reply("ready").prefix} {spec.name} {spec.short_fingerprint} {spec.integrity}' in header
 
 
 def test_the_fingerprint_follows_the_spec_content_not_its_comments_or_layout(tmp_path: Path) -> None:

@@ -194,8 +194,6 @@ CASES = [
     Hostile("a reply prefix that overflows REPLY_MAX_LENGTH",
             edited(('prefix: "#READY"', 'prefix: "#' + "R" * 240 + '"')),
             (("replies:\n  ^ready", "replies: REPLY_MAX_LENGTH = "),)),
-    Hostile("128 commands for an int8_t index", synthetic(many_commands(128)),
-            (("categories:\n  ^m:", "categories: COMMAND_COUNT = 128 does not fit its C++ type int8_t"),)),
 ]
 
 

@@ -89,7 +89,7 @@ def test_the_python_module_reproduces_table_4() -> None:
 
 
 def test_the_cpp_header_reproduces_table_4() -> None:
-    header = h.HEADER.read_text()
+    header = h.header_text()
     for channel, figures in SEED_TABLE_4.items():
         for key, value in figures.items():
             match = re.search(rf"constexpr uint16_t {channel.upper()}_{key.upper()} = (\d+);", header)

@@ -296,20 +296,20 @@ def test_refound_after_loss_goes_through_acquire_again() -> None:
 
 def test_failsafe_reply_switches_laser_belief_off_and_lands() -> None:
     c, _clock = to_state(State.FIRE)
-    c.on_reply(dp.parse_reply(dp.failsafe_line()))
+    c.on_reply(dp.parse_reply(dp.failsafe_line(dp.DroneState.FAILSAFE, False)))
     assert not c.laser_on and st(c) is State.LAND
     assert "failsafe" in c.transitions[-1].reason
 
 
 def test_not_armed_reply_lands() -> None:
     c, _clock = to_state(State.TRACK)
-    c.on_reply(dp.parse_reply(dp.rejected_line(dp.ErrorKind.NOT_ARMED)))
+    c.on_reply(dp.parse_reply(dp.rejected_line(dp.ErrorKind.NOT_ARMED, dp.DroneState.ARMED, False)))
     assert st(c) is State.LAND
 
 
 def test_busy_reply_during_arming_is_ignored() -> None:
     c, _clock = to_state(State.ARM)
-    c.on_reply(dp.parse_reply(dp.rejected_line(dp.ErrorKind.BUSY)))
+    c.on_reply(dp.parse_reply(dp.rejected_line(dp.ErrorKind.BUSY, dp.DroneState.ARMED, False)))
     assert st(c) is State.ARM
 
 

@@ -88,8 +88,6 @@ def _parse(body: bytes) -> Reply:
             parts = rest.split()
             if len(parts) == 3:
                 return Reply(kind, protocol=parts[0], fingerprint=parts[1], integrity=parts[2])
-            if len(parts) == 2:  # TRANSITION: firmware that does not name its integrity mode yet
-                return Reply(kind, protocol=parts[0], fingerprint=parts[1], integrity="none")
             raise ReplyError(f"malformed ready reply {text!r}: expected '{kind.value} <protocol> <fingerprint> "
                              "<integrity>'")
         rest, state, laser = _status(text, rest)
@@ -106,15 +104,13 @@ def _parse(body: bytes) -> Reply:
     raise ReplyError(f"unknown reply {text!r}: expected a line starting with one of {allowed(starts)}")
 
 
-def _status(text: str, rest: str) -> tuple[str, DroneState | None, bool | None]:
+def _status(text: str, rest: str) -> tuple[str, DroneState, bool]:
     """Split the status off the end of a reply: (the rest, the state, the laser)."""
     cut = len(rest) - 2 - len(STATUS_SEPARATOR)
     if cut >= 0 and rest[cut:cut + len(STATUS_SEPARATOR)] == STATUS_SEPARATOR:
         state, laser = _STATES.get(rest[-2]), _LASER.get(rest[-1])
         if state is not None and laser is not None:
             return rest[:cut], state, laser
-    if _TRANSITION:
-        return rest, None, None
     raise ReplyError(f"reply {text!r} does not end with the drone's status ('{STATUS_SEPARATOR}' + state + laser)")
 
 
@@ -123,30 +119,22 @@ def _line(text: str) -> bytes:
     return data + b"\n"
 
 
-# TRANSITION: until the firmware reports its status, replies without one parse with state and laser None.
-_TRANSITION: Final = True
-
-
-def status_text(state: DroneState | None, laser: bool | None) -> str:
-    if state is None or laser is None:
-        return ""  # TRANSITION
+def status_text(state: DroneState, laser: bool) -> str:
     return f"{STATUS_SEPARATOR}{state.value}{LASER_ON_CODE if laser else LASER_OFF_CODE}"
 
 
 def ready_line() -> bytes:
-    if _TRANSITION:
-        return _line(f"{ReplyKind.READY.value} {PROTOCOL_NAME} {SPEC_FINGERPRINT}")
     return _line(f"{ReplyKind.READY.value} {PROTOCOL_NAME} {SPEC_FINGERPRINT} {INTEGRITY}")
 
 
-def accepted_line(command: Command, state: DroneState | None = None, laser: bool | None = None) -> bytes:
+def accepted_line(command: Command, state: DroneState, laser: bool) -> bytes:
     return _line(f"{ReplyKind.ACCEPTED.value}{command.category.value}{command.direction.value}"
                  f"{status_text(state, laser)}")
 
 
-def rejected_line(error: ErrorKind, state: DroneState | None = None, laser: bool | None = None) -> bytes:
+def rejected_line(error: ErrorKind, state: DroneState, laser: bool) -> bytes:
     return _line(f"{ReplyKind.REJECTED.value}{error.value}{status_text(state, laser)}")
 
 
-def failsafe_line(state: DroneState | None = None, laser: bool | None = None) -> bytes:
+def failsafe_line(state: DroneState, laser: bool) -> bytes:
     return _line(f"{ReplyKind.FAILSAFE.value}{status_text(state, laser)}")
