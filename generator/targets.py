@@ -17,4 +17,5 @@ TARGETS: tuple[Target, ...] = (
     Target("arduino", "arduino", "//"),
     Target("docs", "docs", "<!--"),
     Target("vectors", "", "json"),
+    Target("typescript", "typescript", "json"),  # its templates print their own headers (JSON, //, <!--)
 )
