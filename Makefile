@@ -63,6 +63,7 @@ demo: deps generate
 -include pilot/pilot.mk
 -include tests/fuzz/fuzz.mk
 -include bench/bench.mk
+-include tests/targets/typescript.mk
 
 clean:
 	rm -rf build firmware/build
