@@ -19,7 +19,7 @@ import drone_protocol as p
 
 
 def decode_lines() -> None:
-    out = []
+    out: list[str] = []
     for line in sys.stdin:
         try:
             cmd = p.decode(bytes.fromhex(line.strip()))
@@ -33,7 +33,7 @@ def decode_lines() -> None:
 
 def stream_lines(kinds: list[str]) -> None:
     decoder = p.StreamDecoder(time_fn=lambda: 0.0)
-    out = []
+    out: list[str] = []
     for line in sys.stdin:
         parts = line.split()
         if not parts:
