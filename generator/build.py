@@ -10,10 +10,11 @@ from typing import TypeVar
 
 from generator import __version__
 from generator.errors import SpecError, SpecInvalid
-from generator.model import Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
+from generator.model import INTEGRITY_MODES, Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
 from generator.names import identifier_problem
 from generator.reader import Reader, is_int, kind_name
 from generator.source import INVALID, Node, load
+from generator.status import read_status
 
 T = TypeVar("T")
 
@@ -24,6 +25,8 @@ PARSER_ERRORS = ("bad_category", "bad_direction", "bad_digit", "out_of_range", "
 STREAM_ERRORS = PARSER_ERRORS[:5]
 # The ones decode() and encode() raise (timeout is the stream's alone).
 FRAME_ERRORS = tuple(e for e in PARSER_ERRORS if e != "timeout")
+# Refusals the generated dispatch (unsupported), the integrity check (bad_check) and the firmware reply with.
+REFUSALS = ("unsupported", "bad_check", "not_armed", "busy", "armed", "airborne")
 REPLIES = ("ready", "accepted", "rejected", "failsafe")
 SPEED_LABELS = ("low", "median", "high")
 
@@ -83,6 +86,11 @@ class _Builder:
                         "a frame is category, direction and 1 to 4 value digits (16-bit values on the Arduino)",
                         frame.sub("length"))
         inter_byte = self._positive(frame, "inter_byte_timeout_ms")
+        integrity = frame.text("integrity", "none")
+        if integrity not in INTEGRITY_MODES:
+            near = difflib.get_close_matches(integrity, INTEGRITY_MODES, n=1)
+            frame.error(frame.node.children["integrity"], f"unknown integrity mode '{integrity}'",
+                        f"did you mean '{near[0]}'?" if near else "none or crc8", frame.sub("integrity"))
         frame.finish()
 
         baud = self._positive(link, "baud")
@@ -108,6 +116,7 @@ class _Builder:
         failsafe_timeout = self._positive(safety, "failsafe_timeout_ms")
         failsafe_throttle = self._positive(safety, "failsafe_throttle_us")
         arming_hold = self._positive(safety, "arming_hold_ms")
+        landing = self._positive(safety, "landing_ms")
         if command_timeout and failsafe_timeout and command_timeout > failsafe_timeout:
             safety.error(safety.node.children["command_timeout_ms"],
                          "command_timeout_ms is longer than failsafe_timeout_ms",
@@ -117,6 +126,7 @@ class _Builder:
         categories = self._categories(top, fields, channels, servos)
         replies = self._replies(top)
         errors = self._errors(top)
+        status = read_status(top, self.errors)
         settled = self._settled(top)
         top.finish()
         if self.errors:
@@ -130,6 +140,7 @@ class _Builder:
             title=title,
             description=description,
             frame_length=length,
+            integrity=integrity,
             inter_byte_timeout_ms=inter_byte,
             baud=baud,
             data_bits=data_bits,
@@ -145,10 +156,12 @@ class _Builder:
             failsafe_timeout_ms=failsafe_timeout,
             failsafe_throttle_us=failsafe_throttle,
             arming_hold_ms=arming_hold,
+            landing_ms=landing,
             fields=tuple(f for f, _, _, _ in fields.values()),
             categories=tuple(categories),
             replies=tuple(replies),
             errors=tuple(errors),
+            status=status,
             settled=tuple(settled),
         )
 
@@ -454,7 +467,7 @@ class _Builder:
                 continue
             codes[code] = name
             kinds.append(ErrorKind(len(kinds) + 1, name, code, description))
-        self._require_all(top, "errors", PARSER_ERRORS, {k.name for k in kinds})
+        self._require_all(top, "errors", PARSER_ERRORS + REFUSALS, {k.name for k in kinds})
         # The parser's kinds come first, in a fixed order, so generated code can count them in one array.
         order = sorted(kinds, key=lambda k: (PARSER_ERRORS.index(k.name) if k.name in PARSER_ERRORS
                                              else len(PARSER_ERRORS), k.index))

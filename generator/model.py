@@ -109,6 +109,34 @@ class Reply:
 
 
 @dataclass(frozen=True)
+class StatusState:
+    """One state of the drone's state machine as its replies report it."""
+
+    name: str
+    code: str
+    armed: bool  # the motors may spin in this state
+    description: str
+
+
+@dataclass(frozen=True)
+class Status:
+    """What every accepted, rejected and failsafe reply carries after `separator`: a state code, a laser code."""
+
+    states: tuple[StatusState, ...]
+    laser_off: str
+    laser_on: str
+    separator: str = " "
+
+    def state(self, name: str) -> StatusState:
+        return next(s for s in self.states if s.name == name)
+
+    @property
+    def length(self) -> int:
+        """Characters the status adds to a reply line."""
+        return len(self.separator) + 2
+
+
+@dataclass(frozen=True)
 class Settled:
     """One inconsistency of the seed document and what the spec decides."""
 
@@ -141,6 +169,7 @@ class Spec:
     title: str
     description: str
     frame_length: int
+    integrity: str  # "none" or "crc8" (INTEGRITY_MODES)
     inter_byte_timeout_ms: int
     baud: int
     data_bits: int
@@ -156,10 +185,12 @@ class Spec:
     failsafe_timeout_ms: int
     failsafe_throttle_us: int
     arming_hold_ms: int
+    landing_ms: int
     fields: tuple[Field, ...]
     categories: tuple[Category, ...]
     replies: tuple[Reply, ...]
     errors: tuple[ErrorKind, ...]
+    status: Status
     settled: tuple[Settled, ...]
 
     @property
@@ -198,6 +229,38 @@ class Spec:
     @property
     def digits_width(self) -> int:
         return self.frame_length - 2
+
+    @property
+    def check_length(self) -> int:
+        """Check characters after the frame's bytes on the wire (two hex digits in crc8 mode)."""
+        return CHECK_LENGTH[self.integrity]
+
+    @property
+    def wire_length(self) -> int:
+        return self.frame_length + self.check_length
+
+    def error(self, name: str) -> ErrorKind:
+        return next(e for e in self.errors if e.name == name)
+
+
+# frame.integrity modes and the check characters each appends to a frame.
+CHECK_LENGTH = {"none": 0, "crc8": 2}
+INTEGRITY_MODES = tuple(CHECK_LENGTH)
+
+
+def crc8(data: bytes) -> int:
+    """CRC-8/SMBUS (poly 0x07, init 0, no reflection): the check of frame.integrity crc8."""
+    crc = 0
+    for byte in data:
+        crc ^= byte
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x07) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
+    return crc
+
+
+def check_text(data: bytes) -> str:
+    """The two upper-case hex digits appended to a frame (or after '*' to a reply) in crc8 mode."""
+    return f"{crc8(data):02X}"
 
 
 def _lookup(index_by_code: dict[int, int]) -> ByteLookup:

@@ -72,8 +72,8 @@ def render_all(spec: Spec) -> dict[str, bytes]:
         root = TEMPLATES / target.name
         for template_path in sorted(root.rglob("*.j2")):
             rel = template_path.relative_to(root).as_posix()
-            if template_path.name.startswith("_"):
-                continue  # a partial, included by another template of the folder
+            if template_path.name.startswith("_") and not template_path.name.startswith("__"):
+                continue  # a partial (_name, not __init__), included by another template of the folder
             text = env.get_template(rel).render(context)
             out = rel[: -len(".j2")]
             for placeholder, value in names.items():

@@ -130,7 +130,8 @@ def test_every_valid_vector_gives_its_pulses_and_reply() -> None:
         plan.check(model.widths(), model.laser, [reply(dp.accepted_line(dp.decode(frame)))], v["frame"])
         plan.wait(SLOT_MS)
     init = {v["command"]: bytes.fromhex(v["frame_hex"]) for v in by_category["i"]}
-    assert set(init) == {"arm", "disarm", "hold_altitude", "first_test"}, "a new init routine needs a check here"
+    assert set(init) == {"arm", "disarm", "hold_altitude", "first_test", "land"}, \
+        "a new init routine needs a check here"
     plan.send(init["hold_altitude"])
     plan.check(model.widths(), model.laser, [reply(dp.accepted_line(dp.decode(init["hold_altitude"])))], "is")
     plan.wait(SLOT_MS)

@@ -113,7 +113,7 @@ def test_python_and_cpp_agree_on_a_large_sample_of_6_byte_inputs() -> None:
     outcomes = collections.Counter(r.split()[1] if r.startswith("err") else "ok" for r in python)
     for outcome in ("ok", "bad_category", "bad_direction", "bad_digit", "out_of_range"):
         assert outcomes[outcome] >= SAMPLE_SIZE // 50, outcomes
-    assert len({r for r in python if r.startswith("ok")}) > 1_000, "too few distinct valid commands"
+    assert len({r for r in python if r.startswith("ok")}) > 500, "too few distinct valid commands"
 
 
 def test_python_and_cpp_agree_on_every_length() -> None:

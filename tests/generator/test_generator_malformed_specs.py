@@ -72,7 +72,7 @@ CASES = [
          (("sens: 1", "categories.s.directions.u.sens: unknown key 'sens' (hint: did you mean 'sense'?)"),)),
     Case("unknown top-level key lists the known ones", (("# Tables 1, 2, 3, 5 and 6.\n", "notes: hello\n"),),
          (("notes: hello", "notes: unknown key 'notes' (hint: known keys: categories, channels, errors, fields, "
-           "flight_modes, frame, link, protocol, replies, safety, servos, settled, speeds)"),)),
+           "flight_modes, frame, link, protocol, replies, safety, servos, settled, speeds, status)"),)),
     Case("missing key", (("        name: backward\n", ""),),
          (("description: Backward", "categories.m.directions.b.name: missing key 'name'"),)),
     Case("missing key of a category: no field for its directions",
@@ -163,7 +163,8 @@ CASES = [
     Case("Python reserved word", (("        name: forward", "        name: class"),),
          (("class", f"categories.m.directions.f.name: 'class' is a reserved word in a target language {IDENT_HINT}"),)),
     Case("Python soft keyword", (("        name: forward", "        name: match"),),
-         (("match", f"categories.m.directions.f.name: 'match' is a reserved word in a target language {IDENT_HINT}"),)),
+         (("name: ^match",
+           f"categories.m.directions.f.name: 'match' is a reserved word in a target language {IDENT_HINT}"),)),
     Case("C++ reserved word", (("        name: forward", "        name: delete"),),
          (("delete",
            f"categories.m.directions.f.name: 'delete' is a reserved word in a target language {IDENT_HINT}"),)),
@@ -245,7 +246,7 @@ CASCADES = [
     Case("wrong type: text for an integer", (("  inter_byte_timeout_ms: 20", "  inter_byte_timeout_ms: twenty"),),
          (("twenty", "frame.inter_byte_timeout_ms: expected an integer, found text 'twenty'"),)),
     Case("wrong type: boolean for an integer", (("  baud: 115200", "  baud: true"),),
-         (("true", "link.baud: expected an integer, found a boolean True"),)),
+         (("baud: ^true", "link.baud: expected an integer, found a boolean True"),)),
     Case("wrong type: integer for a name", (("    name: turn\n", "    name: 5\n"),),
          (("  t:\n    name: ^5", "categories.t.name: expected text, found an integer 5"),)),
     Case("python tag on a scalar is refused, not constructed",
@@ -262,7 +263,10 @@ CASCADES = [
          (("        name: toggle\n", "        name: toggle\n        default: 5\n"),),
          (("default: ^5", "categories.l.directions.0.default: default 5 is outside range 0..0"),)),
     Case("empty directions",
-         (('    directions:\n      "0":\n        name: toggle\n        description: Toggle the laser\n',
+         (('    directions:\n      "0":\n        name: toggle\n'
+           '        description: Toggle the laser (the seed\'s frame)\n'
+           '      "n":\n        name: "on"\n        description: Switch the laser on\n'
+           '      f:\n        name: "off"\n        description: Switch the laser off\n',
            "    directions: {}\n"),),
          (("{}", "categories.l.directions: must not be empty"),)),
 ]

@@ -120,7 +120,7 @@ static int run_replies() {
     const Command cmd{static_cast<CommandId>(i), info.category, info.direction, info.min};
     print_line(line, write_accepted(cmd, line));
   }
-  for (uint8_t e = 1; e <= static_cast<uint8_t>(Error::Busy); ++e) print_line(line, write_rejected(static_cast<Error>(e), line));
+  for (uint8_t e = 1; e <= ERROR_COUNT; ++e) print_line(line, write_rejected(static_cast<Error>(e), line));
   print_line(line, write_failsafe(line));
   return 0;
 }
