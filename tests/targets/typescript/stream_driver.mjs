@@ -8,8 +8,9 @@
 //   whole ms) and the bytes received at that time in hex (two digits each, no separators; may be empty).
 //   Blank lines are ignored. Every byte goes through StreamParser.feed(byte, now_ms), one at a time.
 // stdout: "<command name> <value>" for every frame the parser completes, in order (e.g. "move_forward 1600"),
-//   then one last line "errors <name>=<n> ..." with the count of every kind the stream parser counts, in the
-//   spec's order (e.g. "errors bad_category=4 bad_direction=0 bad_digit=0 out_of_range=0 timeout=1").
+//   then one last line "errors <name>=<n> ..." with the count of every error kind of the spec, in the spec's
+//   order (e.g. "errors bad_category=4 bad_direction=0 ... timeout=1 ... busy=0 ..."; kinds the stream parser
+//   never meets are 0), the format the Python, C++, C and Rust drivers of tests/targets/drivers/ share.
 // A malformed input line exits 2 with a message on stderr.
 import { createInterface } from "node:readline";
 import { dirname, join, resolve } from "node:path";
@@ -17,7 +18,7 @@ import { fileURLToPath, pathToFileURL } from "node:url";
 
 const here = dirname(fileURLToPath(import.meta.url));
 const dist = resolve(process.argv[2] ?? join(here, "../../../build/typescript/package/dist"));
-const { StreamParser, STREAM_ERRORS } = await import(pathToFileURL(join(dist, "index.js")).href);
+const { StreamParser, ERRORS } = await import(pathToFileURL(join(dist, "index.js")).href);
 
 const parser = new StreamParser();
 const out = [];
@@ -39,5 +40,5 @@ for await (const line of createInterface({ input: process.stdin, crlfDelay: Infi
   }
   if (out.length >= 4096) process.stdout.write(out.splice(0).join("\n") + "\n");
 }
-out.push(`errors ${STREAM_ERRORS.map((name) => `${name}=${parser.errorCount(name)}`).join(" ")}`);
+out.push(`errors ${Object.keys(ERRORS).map((name) => `${name}=${parser.errorCount(name)}`).join(" ")}`);
 process.stdout.write(out.join("\n") + "\n");

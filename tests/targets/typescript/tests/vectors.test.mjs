@@ -72,36 +72,42 @@ test("encode() refuses what the protocol does not allow", () => {
   if (single !== undefined) assert.equal(code(() => dp.encode(single.code)), "accepted");
 });
 
-test("the spec's tables, fingerprint and reply lines are the Python module's", () => {
+test("the spec's tables and fingerprint are the Python module's, and its accepted lines parse", () => {
   const py = JSON.parse(reference("info"));
   assert.equal(dp.SPEC_FINGERPRINT, py.fingerprint);
   assert.equal(dp.SPEC_SHA256, py.sha256);
   assert.deepEqual(Object.fromEntries(Object.entries(dp.ERRORS).map(([name, e]) => [name, e.code])), py.errors);
   assert.deepEqual(Object.fromEntries(Object.values(dp.COMMANDS).map((s) =>
     [s.name, [s.category, s.direction, s.minimum, s.maximum, s.default]])), py.commands);
-  assert.equal(dp.readyLine(), py.ready);
-  assert.equal(dp.failsafeLine(), py.failsafe);
-  const commands = Object.values(dp.COMMANDS).map((s) => dp.decode(dp.encode(s.category, s.direction, s.minimum)));
-  assert.deepEqual(commands.map((c) => dp.acceptedLine(c)), py.accepted);
-  assert.deepEqual(Object.keys(dp.ERRORS).map((name) => dp.rejectedLine(name)), py.rejected);
+  const names = Object.keys(dp.COMMANDS);
+  assert.deepEqual(py.accepted.map((line) => dp.parseReply(line)).map((r) => r.kind === "accepted" && r.command), names);
 });
 
-test("parseReply() reads every line the Arduino writes, and refuses others", () => {
-  const ready = dp.parseReply(dp.readyLine());
-  assert.deepEqual(ready, { kind: "ready", protocol: dp.PROTOCOL_NAME, fingerprint: dp.SPEC_FINGERPRINT });
-  for (const spec of Object.values(dp.COMMANDS)) {
-    const line = dp.acceptedLine(dp.decode(dp.encode(spec.category, spec.direction, spec.minimum)));
-    assert.deepEqual(dp.parseReply(line), { kind: "accepted", command: spec.name, category: spec.category, direction: spec.direction });
-    assert.deepEqual(dp.parseReply(new TextEncoder().encode(line.replace("\n", "\r\n"))).kind, "accepted");
+test("parseReply() reads every line the writers write, with every status, and refuses others", () => {
+  const statuses = Object.keys(dp.STATES).flatMap((state) => [{ state, laserOn: false }, { state, laserOn: true }]);
+  assert.deepEqual(dp.parseReply(dp.readyLine()),
+    { kind: "ready", protocol: dp.PROTOCOL_NAME, fingerprint: dp.SPEC_FINGERPRINT, integrity: dp.INTEGRITY });
+  for (const [i, spec] of Object.values(dp.COMMANDS).entries()) {
+    const status = statuses[i % statuses.length];
+    const line = dp.acceptedLine(dp.decode(dp.encode(spec.category, spec.direction, spec.minimum)), status);
+    assert.deepEqual(dp.parseReply(line),
+      { kind: "accepted", command: spec.name, category: spec.category, direction: spec.direction, status });
+    assert.deepEqual(dp.parseReply(new TextEncoder().encode(line.replace("\n", "\r\n"))).status, status);
   }
-  for (const name of Object.keys(dp.ERRORS)) assert.deepEqual(dp.parseReply(dp.rejectedLine(name)), { kind: "rejected", error: name });
-  assert.deepEqual(dp.parseReply(dp.failsafeLine()), { kind: "failsafe" });
+  for (const [i, name] of Object.keys(dp.ERRORS).entries()) {
+    const status = statuses[(3 * i) % statuses.length];
+    assert.deepEqual(dp.parseReply(dp.rejectedLine(name, status)), { kind: "rejected", error: name, status });
+  }
+  for (const status of statuses) assert.deepEqual(dp.parseReply(dp.failsafeLine(status)), { kind: "failsafe", status });
+  const text = dp.failsafeLine(statuses[0]);
+  const state = dp.STATES[statuses[0].state].code;
   const bad = [
     "", "?", dp.REPLIES.accepted.prefix, `${dp.REPLIES.accepted.prefix}??`, `${dp.REPLIES.rejected.prefix}?`,
     `${dp.REPLIES.failsafe.prefix}x`, dp.REPLIES.ready.prefix, `${dp.REPLIES.ready.prefix} one`,
+    text.replace(`${state}${dp.LASER_OFF}`, `${state}?`), `${dp.REPLIES.failsafe.prefix}${dp.STATUS_SEPARATOR}?${dp.LASER_OFF}`,
   ];
   for (const line of bad) {
-    assert.throws(() => dp.parseReply(line), (e) => e instanceof dp.ProtocolError && e.code === "bad_reply", line);
+    assert.throws(() => dp.parseReply(line), (e) => e instanceof dp.ProtocolError && ["bad_reply", "bad_check"].includes(e.code), line);
   }
 });
 
