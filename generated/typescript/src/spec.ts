@@ -35,6 +35,8 @@ export const COMMAND_TIMEOUT_MS = 500;
 export const FAILSAFE_TIMEOUT_MS = 1000;
 export const FAILSAFE_THROTTLE_US = 950;
 export const ARMING_HOLD_MS = 2000;
+/** The landing routine descends this long, then runs the disarm sequence. */
+export const LANDING_MS = 4000;
 export const MODE_STABILIZE_US = 1165;
 export const MODE_ALT_HOLD_US = 1425;
 export const SPEED_STEP_US = 100;

@@ -5,14 +5,14 @@
 //   (`make typescript-console` builds what it needs and runs this), then open
 //   build/typescript/package/dist/console.html?bridge=ws://127.0.0.1:8765 and press "Connect bridge".
 //
-// It starts the virtual drone (the firmware's host build) in real time on a pseudo-terminal, and for one
-// WebSocket client at a time opens that pty like a serial port (which reboots the virtual board: it prints its
-// ready line) and copies bytes both ways, one binary message per chunk. The tests import startBridge().
+// It starts the virtual drone (the firmware's host build) in real time on a pseudo-terminal, holds the pty open
+// like a serial port, and copies bytes between it and one WebSocket client at a time, one binary message per
+// chunk. Each new client reboots the virtual board (an open of the pty does, as DTR does a real Uno's), so it
+// gets the ready line. The tests import startBridge().
 import { spawn } from "node:child_process";
-import { constants, openSync, writeSync } from "node:fs";
+import { closeSync, constants, createReadStream, openSync, writeSync } from "node:fs";
 import { once } from "node:events";
 import { createInterface } from "node:readline";
-import tty from "node:tty";
 import { fileURLToPath } from "node:url";
 import { WebSocketServer } from "ws";
 
@@ -40,32 +40,32 @@ export async function startBridge({ executable, port = 0, host = "127.0.0.1", lo
     }
   });
 
-  const server = new WebSocketServer({ host, port });
-  await once(server, "listening");
+  // A blocking descriptor read through the thread pool (a tty stream on a pty slave here saw no bytes); the
+  // stream closes it once the drone has exited.
+  const fd = openSync(pty, constants.O_RDWR | constants.O_NOCTTY);
+  const input = createReadStream(null, { fd, highWaterMark: 256 });
   let client = null;
   let written = 0;
+  input.on("data", (chunk) => client?.send(chunk));
+  input.on("error", () => {}); // EIO once the drone has exited
+  const server = new WebSocketServer({ host, port });
+  await once(server, "listening");
   server.on("connection", (socket) => {
     if (client !== null) {
       socket.close(1013, "the virtual drone has a client already");
       return;
     }
     client = socket;
-    // Opening the port reboots the virtual board, as DTR does a real Uno.
-    const fd = openSync(pty, constants.O_RDWR | constants.O_NOCTTY);
-    const input = new tty.ReadStream(fd);
-    input.setRawMode(true);
-    input.on("data", (chunk) => socket.send(chunk));
-    input.on("error", (error) => log(`pty: ${error.message}`));
+    closeSync(openSync(pty, constants.O_RDWR | constants.O_NOCTTY)); // reboots the board: a fresh ready line
     socket.on("message", (data) => {
       const bytes = Buffer.isBuffer(data) ? data : Buffer.concat(Array.isArray(data) ? data : [Buffer.from(data)]);
       writeSync(fd, bytes);
       written += bytes.length;
     });
     socket.on("close", () => {
-      input.destroy();
       client = null;
     });
-    log(`client connected; pty ${pty} opened`);
+    log(`client connected to ${pty}`);
   });
 
   const { port: bound } = server.address();
@@ -81,6 +81,7 @@ export async function startBridge({ executable, port = 0, host = "127.0.0.1", lo
         drone.kill("SIGTERM");
         await exited;
       }
+      input.destroy();
     },
   };
 }

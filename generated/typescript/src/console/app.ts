@@ -8,7 +8,7 @@
 import { ProtocolError, encode } from "../codec.js";
 import { LineSplitter, type Reply, type Status, parseReply } from "../replies.js";
 import {
-  COMMANDS, ERRORS, FAILSAFE_TIMEOUT_MS, INTEGRITY, PROTOCOL_NAME, PROTOCOL_TITLE, SPEC_FINGERPRINT, STATES,
+  ARMING_HOLD_MS, COMMANDS, ERRORS, FAILSAFE_TIMEOUT_MS, INTEGRITY, LANDING_MS, PROTOCOL_NAME, PROTOCOL_TITLE, SPEC_FINGERPRINT, STATES,
   type CommandName, type CommandSpec,
 } from "../spec.js";
 import { commandControls, el } from "./controls.js";
@@ -28,6 +28,7 @@ export function startConsole(root: HTMLElement, bridge: string): void {
   let link: Link | null = null;
   let trusted = false; // the drone's ready line carried our fingerprint
   let keepAlive: ReturnType<typeof setInterval> | null = null;
+  let keepAliveEnd: ReturnType<typeof setTimeout> | null = null;
   let safeUntil = 0; // the safe button's disarm was sent before this time: an "airborne" refusal lands instead
   const splitter = new LineSplitter();
   const rejected = new Map<string, number>();
@@ -83,10 +84,12 @@ export function startConsole(root: HTMLElement, bridge: string): void {
     await link.write(frame).catch((error: unknown) => addLog("note", `write failed: ${String(error)}`));
   }
 
-  function setKeepAlive(on: boolean): void {
+  function setKeepAlive(on: boolean, forMs = 0): void {
     keepAliveBox.checked = on;
     if (keepAlive !== null) clearInterval(keepAlive);
-    keepAlive = null;
+    if (keepAliveEnd !== null) clearTimeout(keepAliveEnd);
+    keepAlive = keepAliveEnd = null;
+    if (on && forMs > 0) keepAliveEnd = setTimeout(() => setKeepAlive(false), forMs);
     if (on && KEEP_ALIVE !== null) {
       const spec = COMMANDS[KEEP_ALIVE];
       keepAlive = setInterval(() => void sendCommand(spec, spec.minimum), KEEP_ALIVE_MS);
@@ -110,6 +113,7 @@ export function startConsole(root: HTMLElement, bridge: string): void {
       ready.textContent = `READY ${reply.protocol} ${reply.fingerprint} ${integrity}: ${trusted ? "the drone runs this spec"
         : `DIFFERENT SPEC (this console: ${PROTOCOL_NAME} ${SPEC_FINGERPRINT} ${INTEGRITY}); sending disabled`}`;
       ready.className = trusted ? "ready ok" : "ready bad";
+      if (link !== null) status.textContent = `connected: ${link.label}`;
       failsafe.hidden = true;
       refresh();
     } else if (reply.kind === "accepted") {
@@ -165,12 +169,13 @@ export function startConsole(root: HTMLElement, bridge: string): void {
   bridgeButton.addEventListener("click", () => void connect(webSocketOpener(bridgeUrl.value)));
   closeButton.addEventListener("click", () => void link?.close());
   keepAliveBox.addEventListener("change", () => setKeepAlive(keepAliveBox.checked));
-  // Then keep the link alive, so that the disarm (or landing) sequence runs to its end instead of the failsafe.
+  // Then keep the link alive until a landing and the disarm sequence have had time to end, so that they run to
+  // their end instead of the failsafe.
   safeButton.addEventListener("click", () => {
     safeUntil = Date.now() + FAILSAFE_TIMEOUT_MS;
     void (async () => {
       for (const name of SAFE_SEQUENCE) await sendCommand(COMMANDS[name], COMMANDS[name].minimum);
-      setKeepAlive(true);
+      setKeepAlive(true, LANDING_MS + ARMING_HOLD_MS + FAILSAFE_TIMEOUT_MS);
     })();
   });
 
