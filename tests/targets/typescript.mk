@@ -62,3 +62,4 @@ typescript-console: $(TS_STAMP) $(FW_HOST_DIR)/virtual_drone
 
 bench-typescript: $(TS_STAMP)
 	$(TS_ENV) node bench/typescript/bench.mjs
+bench: bench-typescript
