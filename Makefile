@@ -9,8 +9,10 @@ PY := $(VENV)/bin/python
 VENV_STAMP := $(VENV)/.installed
 APT_STAMP := build/.apt-packages
 
-# Debian 12 packages: the AVR toolchain and Arduino core, simavr, host compilers, clang + libFuzzer, valgrind.
+# Debian 12 packages: the AVR toolchain and Arduino core, arduino-builder (the IDE's builder) and avrdude,
+# simavr, host compilers, clang + libFuzzer, valgrind.
 APT_PACKAGES := make gcc g++ python3 python3-venv python3-pip gcc-avr binutils-avr avr-libc arduino-core-avr \
+                arduino-builder avrdude \
                 simavr libsimavr-dev libelf-dev pkg-config clang libclang-rt-14-dev valgrind
 
 .PHONY: all demo test deps generate check-generated lint typecheck pytest fuzz fuzz-smoke bench clean
@@ -19,7 +21,7 @@ all: generate
 
 deps: $(APT_STAMP) $(VENV_STAMP)
 
-$(APT_STAMP):
+$(APT_STAMP): Makefile  # a package added here is installed on the next run
 	@missing=$$(for p in $(APT_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null \
 	    | grep -q "install ok installed" || echo $$p; done); \
 	if [ -n "$$missing" ]; then \
@@ -48,7 +50,7 @@ lint: $(VENV_STAMP)
 	$(VENV)/bin/ruff check --output-format concise .
 
 typecheck: $(VENV_STAMP)
-	$(VENV)/bin/mypy --strict generator generated/python/drone_protocol pilot tests bench
+	$(VENV)/bin/mypy --strict generator generated/python/drone_protocol pilot tests bench firmware/ide
 
 pytest: deps
 	$(PY) -m pytest -q tests
@@ -63,6 +65,7 @@ demo: deps generate
 -include pilot/pilot.mk
 -include tests/fuzz/fuzz.mk
 -include bench/bench.mk
+-include tests/targets/targets.mk
 -include tests/targets/typescript.mk
 
 clean:

@@ -3,18 +3,27 @@
 #   make bench-protocol   Python codec vs f-string/slice floors, C++ StreamParser throughput and instructions per
 #                         frame, parser flash/RAM on the ATmega328P, generator run time; writes
 #                         bench/protocol/RESULTS.md
-#   make bench            every part's benchmark: bench-protocol, bench-firmware (firmware/firmware.mk) and
-#                         bench-pilot (pilot/pilot.mk)
+#   make bench-vision     the detectors on real photographs (scikit-image's) under 10 conditions, empty and
+#                         distractor views, tuning and held-out photos, time vs the cvtColor+inRange floor;
+#                         writes bench/vision/RESULTS.md (BENCH_VISION_FLAGS=--quick for a smoke run)
+#   make bench            every part's benchmark: bench-protocol, bench-firmware (firmware/firmware.mk),
+#                         bench-pilot (pilot/pilot.mk), bench-vision and bench-ide
+#                         (bench/ide/bench.mk)
 #
 # BENCH_PROTOCOL_FLAGS=--quick for a smoke run (fewer repetitions; still writes RESULTS.md unless --no-write).
 
 BENCH_PROTOCOL_BUILD ?= build/bench/protocol
 BENCH_PROTOCOL_FLAGS ?=
 
-.PHONY: bench bench-protocol bench-firmware bench-pilot
+BENCH_VISION_FLAGS ?=
+
+.PHONY: bench bench-protocol bench-firmware bench-pilot bench-vision bench-ide
 
 # Run benchmarks one at a time (not with make -j): they time each other otherwise.
-bench: bench-protocol bench-firmware bench-pilot
+bench: bench-protocol bench-firmware bench-pilot bench-vision bench-ide
+
+bench-vision: deps
+	PYTHONPATH=bench/vision $(PY) bench/vision/run.py $(BENCH_VISION_FLAGS)
 
 bench-protocol: deps
 	$(PY) bench/protocol/run.py --build $(BENCH_PROTOCOL_BUILD) $(BENCH_PROTOCOL_FLAGS)

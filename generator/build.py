@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 from typing import TypeVar
 
-from generator import __version__
+from generator import __version__, hardware
 from generator.errors import SpecError, SpecInvalid
 from generator.model import INTEGRITY_MODES, Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
 from generator.names import identifier_problem
@@ -128,6 +128,7 @@ class _Builder:
         errors = self._errors(top)
         status = read_status(top, self.errors)
         settled = self._settled(top)
+        project, wiring = hardware.read(top, channels, list(servos), failsafe_throttle, (stabilize, alt_hold))
         top.finish()
         if self.errors:
             return None
@@ -163,6 +164,8 @@ class _Builder:
             errors=tuple(errors),
             status=status,
             settled=tuple(settled),
+            project=project,
+            wiring=wiring,
         )
 
     # -- helpers -------------------------------------------------------------------------------------------

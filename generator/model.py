@@ -160,6 +160,36 @@ class Vector:
 
 
 @dataclass(frozen=True)
+class Project:
+    """Who publishes the generated library and packages (spec section `project`)."""
+
+    author: str
+    maintainer: str
+    url: str
+
+
+@dataclass(frozen=True)
+class WiredPin:
+    name: str  # a channel name or "mode" (RC outputs), a servo name, "laser" or "ppm"
+    pin: int  # Arduino pin number
+    rc_input: int  # 1-based flight-controller input (RC channel), 0 for outputs that are not RC
+
+
+@dataclass(frozen=True)
+class Wiring:
+    """Where the firmware's outputs leave the Arduino (spec section `wiring`)."""
+
+    rc_inputs: tuple[WiredPin, ...]  # in the flight controller's input order
+    servos: tuple[WiredPin, ...]
+    laser: WiredPin
+    ppm: WiredPin
+
+    def rc_input(self, name: str) -> int:
+        """The flight-controller input an RC output is wired to, 0 when the spec wires none of that name."""
+        return next((p.rc_input for p in self.rc_inputs if p.name == name), 0)
+
+
+@dataclass(frozen=True)
 class Spec:
     source_name: str
     fingerprint: str  # sha256 of the canonical spec, hex
@@ -192,6 +222,13 @@ class Spec:
     errors: tuple[ErrorKind, ...]
     status: Status
     settled: tuple[Settled, ...]
+    project: Project
+    wiring: Wiring
+
+    @property
+    def package_version(self) -> str:
+        """protocol.version as the version of the generated library and packages (semantic: N -> N.0.0)."""
+        return f"{self.version}.0.0"
 
     @property
     def short_fingerprint(self) -> str:
@@ -241,6 +278,13 @@ class Spec:
 
     def error(self, name: str) -> ErrorKind:
         return next(e for e in self.errors if e.name == name)
+
+    def wire(self, text: str) -> str:
+        """A frame or reply line as it goes on the wire: with its check in crc8 mode (a reply's after '*')."""
+        if self.integrity == "none":
+            return text
+        data = text.encode("ascii")
+        return text + check_text(data) if len(data) == self.frame_length else text + "*" + check_text(data)
 
 
 # frame.integrity modes and the check characters each appends to a frame.

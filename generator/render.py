@@ -9,11 +9,11 @@ from pathlib import Path
 
 import jinja2
 
-from generator import filters
+from generator import ardupilot, filters
 from generator.build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
 from generator.model import Spec
 from generator.names import pascal
-from generator.targets import TARGETS, Target
+from generator.targets import TARGETS, Target, comment_style
 from generator.vectors import build_vectors
 
 TEMPLATES = Path(__file__).parent / "templates"
@@ -27,13 +27,14 @@ def header_lines(spec: Spec) -> list[str]:
     ]
 
 
-def _with_header(target: Target, text: str, spec: Spec) -> str:
+def _with_header(path: str, text: str, spec: Spec) -> str:
     lines = header_lines(spec)
-    if target.comment == "json":
+    style = comment_style(path)
+    if style == "json":
         return text  # JSON has no comments: its template prints the header as its first member
-    if target.comment == "<!--":
+    if style == "<!--":
         return "<!--\n" + "\n".join(lines) + "\n-->\n" + text
-    return "".join(f"{target.comment} {line}\n" for line in lines) + text
+    return "".join(f"{style} {line}\n" for line in lines) + text
 
 
 def _environment(target: Target) -> jinja2.Environment:
@@ -55,12 +56,14 @@ def render_all(spec: Spec) -> dict[str, bytes]:
     context = {
         "spec": spec,
         "vectors": build_vectors(spec),
+        "ardupilot": ardupilot.parameters(spec),
         "header": header_lines(spec),
         "header_json": json.dumps(
             {"notice": header_lines(spec)[0], "fingerprint": spec.fingerprint, "spec": spec.source_name,
              "generator": spec.generator_version}, sort_keys=True),
         "library": pascal(spec.name),
         "frame_errors": FRAME_ERRORS,
+        "raised_errors": (*FRAME_ERRORS, "bad_check"),  # the error kinds decode() raises as exceptions
         "parser_error_count": sum(1 for e in spec.errors if e.name in PARSER_ERRORS),
         "stream_error_count": len(STREAM_ERRORS),
         "reply_max_length": max(len(spec.reply("ready").prefix) + len(spec.name) + 19,
@@ -79,7 +82,7 @@ def render_all(spec: Spec) -> dict[str, bytes]:
             for placeholder, value in names.items():
                 out = out.replace(placeholder, value)
             path = f"{target.out_dir}/{out}" if target.out_dir else out
-            files[path] = _with_header(target, text, spec).encode("utf-8")
+            files[path] = (text if target.own_header else _with_header(path, text, spec)).encode("utf-8")
     return files
 
 

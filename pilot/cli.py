@@ -20,7 +20,7 @@ from types import FrameType
 import drone_protocol as dp
 
 from pilot import config as config_mod
-from pilot.calibrate import Roi, calibrate_to_config
+from pilot.calibrate import Roi, calibrate_to_config, preview_path
 from pilot.config import PilotConfig
 from pilot.controller import Controller, State
 from pilot.detect import make_detector
@@ -109,7 +109,8 @@ class _StillSim:
         self.scenario = make_scenario(scenario_name, seed)
         self.renderer = Renderer(self.scenario, CameraModel(*size))
         x, y, heading = self.scenario.start
-        self.pose = CameraPose.from_drone(x, y, 1.2, heading, dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default)
+        pan, tilt = dp.SERVOS[dp.ServoName.PAN], dp.SERVOS[dp.ServoName.TILT]
+        self.pose = CameraPose.from_drone(x, y, 1.2, heading, pan.default, tilt.default)
         self._index = 0
 
     def read(self) -> Frame | None:
@@ -243,7 +244,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             if not args.config:
                 raise PilotError("option --calibrate needs --config FILE to save the ranges into")
             cfg = calibrate_to_config(args.calibrate, args.config, _roi(args.roi))
-            print(f"pilot: saved HSV ranges {cfg.hsv.ranges} to {args.config}")
+            print(f"pilot: saved HSV ranges {cfg.hsv.ranges} to {args.config}; preview {preview_path(args.config)}")
             return EXIT_OK
         cfg = _load_config(args)
         if args.port and args.sim:

@@ -40,7 +40,8 @@ from dataclasses import dataclass
 import drone_protocol as dp
 
 from pilot.config import ControllerConfig
-from pilot.detect import Detection
+from pilot.detection import Detection
+from pilot.gating import Gate
 
 
 class State(enum.Enum):
@@ -88,6 +89,7 @@ class Controller:
     ) -> None:
         self.cfg = config or ControllerConfig()
         self._clock = clock
+        self.gate = Gate(self.cfg)  # vision gate (issue 12): every sighting and every laser-on goes through it
         self.state = State.IDLE
         self.transitions: list[Transition] = []
         self.laser_on = False
@@ -196,6 +198,16 @@ class Controller:
     # -- the state machine -----------------------------------------------------------------------
     def update(self, det: Detection | None) -> bytes | None:
         """One frame's decision. ``det`` is None when there is no frame this tick."""
+        # -- vision gate (issue 12): a bad frame holds (laser off), too many in a row land ------------
+        self.gate.observe(det)
+        if self.gate.fault is not None and self.state in FLYING - {State.TAKEOFF, State.HOLD}:
+            if self.gate.fault_frames >= self.cfg.blind_frames:
+                off = self._laser(False)
+                self._go(State.LAND, f"camera: {self.gate.fault.value} frames")
+                return off if off is not None else self._on_land(det)
+            off = self._laser(False)
+            return off if off is not None else self._emit(dp.hold_altitude())
+        # -- end of the vision gate --------------------------------------------------------------------
         handler = getattr(self, f"_on_{self.state.value}")
         result: bytes | None = handler(det)
         return result
@@ -228,7 +240,7 @@ class Controller:
         return self._emit(dp.hold_altitude())
 
     def _found(self, det: Detection | None) -> bool:
-        return det is not None and det.found
+        return det is not None and det.found and self.gate.acquired()  # vision gate: confident enough
 
     def _on_search(self, det: Detection | None) -> bytes | None:
         if self._found(det):
@@ -276,7 +288,7 @@ class Controller:
     def _on_track(self, det: Detection | None) -> bytes | None:
         if self._lost(det, self.cfg.lost_frames):
             return self._to_search("target lost while tracking")
-        if det is None or not det.found:
+        if det is None or not self._found(det):
             if self._coast is not None and self._misses <= self.cfg.coast_frames:
                 return self._emit(self._coast)  # a missed frame or two (a far, flickering target): keep approaching
             return self._emit(dp.hold_altitude())
@@ -333,7 +345,7 @@ class Controller:
     def _on_aim(self, det: Detection | None) -> bytes | None:
         if self._lost(det, self.cfg.lost_frames):
             return self._to_search("target lost while aiming")
-        if det is None or not det.found:
+        if det is None or not self._found(det):
             return self._emit(dp.hold_altitude())
         self._remember_side(det)
         if det.relative_size < self.cfg.retreat_size:
@@ -344,7 +356,7 @@ class Controller:
             self._centred = 0
             return correction
         self._centred += 1
-        if self._centred >= self.cfg.aim_frames:
+        if self._centred >= self.cfg.aim_frames and self.gate.confirmed():  # vision gate: confirmed to fire
             self._go(State.FIRE, "locked and centred")
             self._fire_started_ms = self._now()
             self.lit_ms = 0
@@ -358,7 +370,7 @@ class Controller:
             off = self._laser(False)
             self._go(State.LAND, f"laser on target for {lit_now} ms")
             return off if off is not None else self._on_land(det)
-        if det is None or not det.found:
+        if det is None or not self._found(det):
             self._misses += 1
             off = self._laser(False)  # never lit without a lock
             if self._misses >= self.cfg.lost_frames:
@@ -371,6 +383,9 @@ class Controller:
             off = self._laser(False)
             self._go(State.AIM, "off centre while firing")
             return off if off is not None else self._on_aim(det)
+        if not self.gate.confirmed():  # vision gate: found, but not confirmed in enough frames in a row
+            off = self._laser(False)
+            return off if off is not None else self._emit(dp.hold_altitude())
         on = self._laser(True)
         if on is not None:
             return on

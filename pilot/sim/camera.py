@@ -51,7 +51,7 @@ class CameraPose:
     def from_drone(x: float, y: float, z: float, heading: float, pan_deg: float, tilt_deg: float) -> CameraPose:
         """Servo angles in degrees: at the spec's defaults (``drone_protocol.SERVOS``) the camera looks straight
         ahead and level; pan above its default looks right (``servo_right``), tilt above looks up (``servo_up``)."""
-        pan0, tilt0 = dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default
+        pan0, tilt0 = dp.SERVOS[dp.ServoName.PAN].default, dp.SERVOS[dp.ServoName.TILT].default
         return CameraPose((x, y, z), heading - math.radians(pan_deg - pan0), math.radians(tilt_deg - tilt0))
 
     def axes(self) -> tuple[FloatArray, FloatArray, FloatArray]:

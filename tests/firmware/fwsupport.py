@@ -48,7 +48,7 @@ def neutral() -> dict[str, int]:
 
 def on_ground() -> dict[str, int]:
     """Sticks neutral with the throttle at its minimum: disarmed or armed on the ground."""
-    return {**neutral(), "throttle": dp.CHANNELS["throttle"].minimum}
+    return {**neutral(), "throttle": dp.CHANNELS[dp.ChannelName.THROTTLE].minimum}
 
 
 # --- the virtual drone, driven with a stepped clock ------------------------------------------------------------

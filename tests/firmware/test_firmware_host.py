@@ -50,7 +50,7 @@ def test_boot_prints_ready_with_the_spec_fingerprint_and_outputs_are_safe() -> N
     assert boot["t_ms"] == 0
     assert sticks(boot) == fw.on_ground()
     assert boot["mode"] == dp.MODE_STABILIZE_US
-    assert (boot["pan"], boot["tilt"]) == (dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default)
+    assert (boot["pan"], boot["tilt"]) == (dp.SERVOS[dp.ServoName.PAN].default, dp.SERVOS[dp.ServoName.TILT].default)
     assert boot["laser"] is False and boot["armed"] is False and boot["state"] == "disarmed"
     assert len(trace.changes) == 1  # nothing moves by itself before the failsafe time
 
@@ -72,8 +72,8 @@ def test_arming_holds_throttle_low_and_yaw_right_for_the_arming_time() -> None:
     assert trace.replies(since_ms=10)[0] == accepted(dp.arm())
     start = trace.first_change(state="arming")
     assert start["t_ms"] == 11  # the frame is read on the next millisecond
-    assert start["throttle"] == dp.CHANNELS["throttle"].minimum
-    assert start["yaw"] == dp.CHANNELS["yaw"].maximum  # full right
+    assert start["throttle"] == dp.CHANNELS[dp.ChannelName.THROTTLE].minimum
+    assert start["yaw"] == dp.CHANNELS[dp.ChannelName.YAW].maximum  # full right
     assert start["mode"] == dp.MODE_STABILIZE_US
     done = trace.first_change(armed=True)
     assert done["t_ms"] == start["t_ms"] + dp.ARMING_HOLD_MS
@@ -91,8 +91,8 @@ def test_disarming_holds_throttle_low_and_yaw_left_then_disarms() -> None:
     trace = script.step(10).run()
     assert accepted(dp.disarm()) in trace.replies(since_ms=t0)
     start = trace.first_change(since_ms=t0, state="disarming")
-    assert start["throttle"] == dp.CHANNELS["throttle"].minimum
-    assert start["yaw"] == dp.CHANNELS["yaw"].minimum  # full left
+    assert start["throttle"] == dp.CHANNELS[dp.ChannelName.THROTTLE].minimum
+    assert start["yaw"] == dp.CHANNELS[dp.ChannelName.YAW].minimum  # full left
     assert start["mode"] == dp.MODE_STABILIZE_US  # stick disarming needs a manual-throttle mode
     assert start["armed"] is True
     done = trace.first_change(since_ms=t0, armed=False)
@@ -138,7 +138,7 @@ def test_servo_and_laser_frames_do_not_end_a_movement() -> None:
     trace = script.step(dp.COMMAND_TIMEOUT_MS).run()
     during = trace.state_at(t0 + 150)
     assert during["state"] == "moving" and during["pitch"] == 1700
-    assert during["pan"] == dp.SERVOS["pan"].default - 20 and during["laser"] is True
+    assert during["pan"] == dp.SERVOS[dp.ServoName.PAN].default - 20 and during["laser"] is True
     back = trace.first_change(since_ms=t0 + 2, state="hold_altitude")
     assert back["t_ms"] == t0 + 1 + dp.COMMAND_TIMEOUT_MS  # timed from the movement, not the servo frame
 
@@ -181,9 +181,10 @@ def test_servo_reset_returns_both_servos_to_their_defaults() -> None:
         accepted(dp.servo_reset()),
     ]
     moved = trace.state_at(7)
-    assert (moved["pan"], moved["tilt"]) == (dp.SERVOS["pan"].default + 30, dp.SERVOS["tilt"].default + 60)
+    pan, tilt = dp.SERVOS[dp.ServoName.PAN], dp.SERVOS[dp.ServoName.TILT]
+    assert (moved["pan"], moved["tilt"]) == (pan.default + 30, tilt.default + 60)
     final = trace.changes[-1]
-    assert (final["pan"], final["tilt"]) == (dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default)
+    assert (final["pan"], final["tilt"]) == (dp.SERVOS[dp.ServoName.PAN].default, dp.SERVOS[dp.ServoName.TILT].default)
 
 
 def test_laser_toggles() -> None:
@@ -312,8 +313,8 @@ def test_self_test_sweeps_servos_blinks_laser_nudges_sticks_without_throttle() -
     assert replies[1] == rejected(dp.ErrorKind.BUSY)
     run = [c for c in trace.changes if c["state"] == "self_test"]
     assert run, trace.changes
-    pan = dp.SERVOS["pan"]
-    tilt = dp.SERVOS["tilt"]
+    pan = dp.SERVOS[dp.ServoName.PAN]
+    tilt = dp.SERVOS[dp.ServoName.TILT]
     assert {pan.minimum, pan.maximum} <= {c["pan"] for c in run}
     assert {tilt.minimum, tilt.maximum} <= {c["tilt"] for c in run}
     blinks = [c["laser"] for c in run]
@@ -321,7 +322,7 @@ def test_self_test_sweeps_servos_blinks_laser_nudges_sticks_without_throttle() -
     for name in ("roll", "pitch", "yaw"):
         seen = {c[name] for c in run}
         assert {dp.CHANNELS[name].low, dp.CHANNELS[name].high} <= seen, name
-    assert {c["throttle"] for c in run} == {dp.CHANNELS["throttle"].minimum}
+    assert {c["throttle"] for c in run} == {dp.CHANNELS[dp.ChannelName.THROTTLE].minimum}
     assert all(c["armed"] is False for c in trace.changes)
     end = trace.changes[-1]
     assert end["state"] == "disarmed"

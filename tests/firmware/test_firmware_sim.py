@@ -39,8 +39,8 @@ class Model:
 
     sticks: dict[str, int] = field(default_factory=fw.on_ground)
     mode: int = dp.MODE_STABILIZE_US
-    pan: int = dp.SERVOS["pan"].default
-    tilt: int = dp.SERVOS["tilt"].default
+    pan: int = dp.SERVOS[dp.ServoName.PAN].default
+    tilt: int = dp.SERVOS[dp.ServoName.TILT].default
     laser: bool = False
 
     def widths(self) -> dict[str, int]:
@@ -115,7 +115,7 @@ def test_every_valid_vector_gives_its_pulses_and_reply() -> None:
         spec = dp.COMMANDS[v["command"]]
         frame = bytes.fromhex(v["frame_hex"])
         if spec.target == "both":
-            model.pan, model.tilt = dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default
+            model.pan, model.tilt = dp.SERVOS[dp.ServoName.PAN].default, dp.SERVOS[dp.ServoName.TILT].default
         else:
             limits = dp.SERVOS[spec.target]
             now = getattr(model, spec.target)
@@ -142,7 +142,7 @@ def test_every_valid_vector_gives_its_pulses_and_reply() -> None:
     plan.check(model.widths(), model.laser, [reply(dp.rejected_line(dp.ErrorKind.BUSY))], "it armed")
     plan.wait(SLOT_MS)
     plan.send(init["disarm"])
-    model.sticks = {**fw.on_ground(), "yaw": dp.CHANNELS["yaw"].minimum}
+    model.sticks = {**fw.on_ground(), "yaw": dp.CHANNELS[dp.ChannelName.YAW].minimum}
     model.mode = dp.MODE_STABILIZE_US
     plan.check(model.widths(), model.laser, [reply(dp.accepted_line(dp.decode(init["disarm"])))], "ik")
     for k in range(1, 8):
@@ -153,7 +153,7 @@ def test_every_valid_vector_gives_its_pulses_and_reply() -> None:
     plan.wait(SLOT_MS)
     plan.send(init["first_test"])  # disarmed: the self-test starts by moving the pan servo to its minimum
     plan.check(
-        {**fw.on_ground(), "pan": fw.servo_us(dp.SERVOS["pan"].minimum)},
+        {**fw.on_ground(), "pan": fw.servo_us(dp.SERVOS[dp.ServoName.PAN].minimum)},
         None,
         [reply(dp.accepted_line(dp.decode(init["first_test"])))],
         "it disarmed",
@@ -238,7 +238,7 @@ def test_failsafe_fires_at_its_time_on_the_real_binary() -> None:
     throttle = fw.PINS["throttle"]
     before = result.widths_us(throttle, last_frame_ms, fired_ms - 1)
     after = result.widths_us(throttle, fired_ms + 21, end)
-    assert before and all(abs(w - dp.CHANNELS["throttle"].minimum) <= TOLERANCE_US for w in before)
+    assert before and all(abs(w - dp.CHANNELS[dp.ChannelName.THROTTLE].minimum) <= TOLERANCE_US for w in before)
     assert after and all(abs(w - dp.FAILSAFE_THROTTLE_US) <= TOLERANCE_US for w in after)
     for name in ("roll", "pitch", "yaw"):
         seen = result.widths_us(fw.PINS[name], fired_ms + 21, end)
@@ -250,7 +250,7 @@ def test_garbage_between_frames_never_changes_an_output_to_an_uncommanded_value(
     plan, model = Plan(), Model()
     arm(plan, model)
     commanded: dict[str, set[int]] = {name: {fw.neutral()[name], fw.on_ground()[name]} for name in fw.STICKS}
-    commanded["yaw"].add(dp.CHANNELS["yaw"].maximum)  # the arming hold
+    commanded["yaw"].add(dp.CHANNELS[dp.ChannelName.YAW].maximum)  # the arming hold
     frames_sent: list[bytes] = []
     sticks = [s for s in dp.COMMANDS.values() if s.category in (dp.Category.MOVE, dp.Category.TURN)]
     for _ in range(60):
@@ -298,8 +298,8 @@ def test_mega_2560_build_drives_the_same_arduino_pins() -> None:
     expected = {
         **fw.on_ground(),
         "mode": dp.MODE_STABILIZE_US,
-        "pan": fw.servo_us(dp.SERVOS["pan"].default + 45),
-        "tilt": fw.servo_us(dp.SERVOS["tilt"].default),
+        "pan": fw.servo_us(dp.SERVOS[dp.ServoName.PAN].default + 45),
+        "tilt": fw.servo_us(dp.SERVOS[dp.ServoName.TILT].default),
     }
     for name, want in expected.items():
         seen = result.widths_us(fw.PINS[name], 100, 200)
@@ -330,4 +330,4 @@ def test_ppm_build_sends_the_rc_channels_as_one_ppm_sum_train() -> None:
     for name in ("pitch", "throttle", "yaw", "mode"):
         assert fw.PINS[name] not in result.pulses, name  # parallel outputs are silent in the PPM build
     pan = result.widths_us(fw.PINS["pan"], 100, 300)
-    assert pan and all(abs(w - fw.servo_us(dp.SERVOS["pan"].default - 30)) <= TOLERANCE_US for w in pan)
+    assert pan and all(abs(w - fw.servo_us(dp.SERVOS[dp.ServoName.PAN].default - 30)) <= TOLERANCE_US for w in pan)

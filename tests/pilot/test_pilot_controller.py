@@ -10,6 +10,7 @@ import pytest
 from pilot.config import ControllerConfig
 from pilot.controller import Controller, State
 from pilot.detect import Detection
+from pilot.detection import range_of
 
 W, H = 320, 240
 CFG = ControllerConfig()
@@ -26,8 +27,10 @@ class Clock:
         self.t += ms / 1000.0
 
 
-def seen(ex: float = 0.0, ey: float = 0.0, size: float = 0.05) -> Detection:
-    return Detection(True, W / 2 + ex * W / 2, H / 2 + ey * H / 2, size * W, 0.95, W, H)
+def seen(ex: float = 0.0, ey: float = 0.0, size: float = 0.05, confidence: float = 0.95) -> Detection:
+    """A measured sighting of the 0.3 m ball, its range from its apparent size."""
+    distance = range_of(size * W, 0.3, W, CFG.horizontal_fov_deg)
+    return Detection(True, W / 2 + ex * W / 2, H / 2 + ey * H / 2, size * W, confidence, W, H, range_m=distance)
 
 
 MISS = Detection(False, width=W, height=H)
@@ -85,7 +88,7 @@ def test_arm_takeoff_hold_search_timing() -> None:
     out = tick(c, clock, MISS)
     assert st(c) is State.TAKEOFF and name(out) == "move_up"
     assert out is not None
-    assert (dp.decode(out).value or 0) > dp.CHANNELS["throttle"].median
+    assert (dp.decode(out).value or 0) > dp.CHANNELS[dp.ChannelName.THROTTLE].median
     for _ in range(CFG.takeoff_ms // 50 - 1):
         assert name(tick(c, clock, MISS)) == "move_up"
     assert name(tick(c, clock, MISS)) == "hold_altitude" and st(c) is State.HOLD
@@ -186,7 +189,7 @@ def test_turn_speed_grows_with_the_error() -> None:
     small = dp.decode(tick(c, clock, seen(0.15)) or b"").value
     large = dp.decode(tick(c, clock, seen(0.9)) or b"").value
     assert small is not None and large is not None
-    assert dp.CHANNELS["yaw"].median < small < large
+    assert dp.CHANNELS[dp.ChannelName.YAW].median < small < large
 
 
 def test_track_to_aim_with_size_hysteresis() -> None:
@@ -245,7 +248,9 @@ def test_laser_only_while_locked_and_centred() -> None:
     assert c.laser_on
     out = tick(c, clock, MISS)  # one missed frame: off at once, still firing
     assert name(out) == "laser_toggle" and not c.laser_on and st(c) is State.FIRE
-    out = tick(c, clock, seen(size=0.25))  # re-found and centred: on again
+    for _ in range(CFG.confirm_frames - 1):  # re-found and centred: confirmed again before the laser goes on
+        assert name(tick(c, clock, seen(size=0.25))) == "hold_altitude" and not c.laser_on
+    out = tick(c, clock, seen(size=0.25))
     assert name(out) == "laser_toggle" and c.laser_on
     out = tick(c, clock, seen(0.3, 0.0, size=0.25))  # off centre: off, back to aiming
     assert name(out) == "laser_toggle" and not c.laser_on and st(c) is State.AIM
