@@ -71,6 +71,7 @@ demo: deps generate
 -include tests/fuzz/fuzz.mk
 -include bench/bench.mk
 -include tests/targets/targets.mk
+-include tests/targets/typescript.mk
 
 clean:
 	rm -rf build firmware/build

@@ -27,6 +27,7 @@ TARGETS: tuple[Target, ...] = (
     Target("ardupilot", "ardupilot"),
     Target("rust", "rust", own_header=True),  # each template prints the header in its file's own syntax
     Target("c", "c"),
+    Target("typescript", "typescript", own_header=True),  # .ts, .mjs, .json, .html: each template prints its header
 )
 
 # How a file carries the header: a line-comment prefix, "<!--" (one block comment), or "json" (no comments:
