@@ -52,7 +52,7 @@ def info() -> None:
         "errors": {kind.name.lower(): kind.value for kind in p.ErrorKind},
         "commands": {s.name: [s.category.value, s.direction.value, s.minimum, s.maximum, s.default]
                      for s in p.COMMANDS.values()},
-        "accepted": [p.accepted_line(c).decode() for c in commands],
+        "accepted": [p.accepted_line(c, p.DroneState.MOVING, False).decode() for c in commands],
     }))
 
 
