@@ -243,6 +243,7 @@ void Drone::update(uint32_t now_ms) {
   if (state_ != State::Failsafe && now_ms - last_frame_ms_ >= dp::FAILSAFE_TIMEOUT_MS) {
     // Link lost: this overrides any movement or sequence in progress.
     if (state_ == State::SelfTest) end_self_test();
+    parser_.expire();  // a partial frame from before the silence never completes after it
     enter(State::Failsafe);
     return;
   }

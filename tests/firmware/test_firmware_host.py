@@ -263,6 +263,19 @@ def test_a_frame_split_by_a_long_pause_is_dropped() -> None:
     assert all(c["pitch"] == fw.neutral()["pitch"] for c in trace.changes if c["t_ms"] >= t0)
 
 
+def test_a_partial_frame_does_not_survive_a_silence_that_wraps_the_parsers_16_bit_gap() -> None:
+    """feed() measures the gap in 16 bits; the failsafe drops the partial frame long before 65.536 s pass."""
+    frame = dp.arm()
+    script = fw.Script()
+    script.step(dp.FAILSAFE_TIMEOUT_MS + 10)  # boot's failsafe is over: the next valid frame is honoured
+    script.send(dp.servo_reset()).step(5)
+    t0 = script.t_ms
+    script.send(frame[:4]).step(65536).send(frame[4:]).step(5)
+    trace = script.run()
+    assert "arming" not in {c["state"] for c in trace.changes if c["t_ms"] >= t0}
+    assert accepted(frame) not in trace.replies(since_ms=t0)
+
+
 def test_a_frame_with_a_short_pause_is_accepted() -> None:
     frame = dp.move_forward(1600)
     script = fw.Script().arm()

@@ -140,6 +140,12 @@ class StreamParser {
   }
   // Bytes of a frame started but not complete.
   uint8_t pending() const { return length_; }
+  // Drops a partial frame (counted as a timeout) when the link has been silent: the firmware calls it when its
+  // failsafe fires, so a partial frame never waits long enough for feed()'s 16-bit gap to wrap (65.536 s) and
+  // be completed by bytes that arrive a minute later.
+  void expire() {
+    if (length_ != 0) drop_stale();
+  }
   void reset() {
     length_ = 0;
     last_error_ = Error::None;
