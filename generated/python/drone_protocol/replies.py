@@ -6,8 +6,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
-from typing import Final
+from typing import Final, NamedTuple
 
 from .codec import BY_BYTES, BytesLike, Command, allowed
 from .errors import ReplyError
@@ -35,8 +34,7 @@ class ReplyKind(_TextEnum):
     FAILSAFE = "!F"
 
 
-@dataclass(frozen=True)
-class Reply:
+class Reply(NamedTuple):
     """One line from the Arduino. Only the fields of its kind are set; every line but the ready line carries
     the drone's state and laser as the drone confirmed them."""
 

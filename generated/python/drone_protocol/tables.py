@@ -6,10 +6,9 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from enum import Enum
 from types import MappingProxyType
-from typing import Final, Union
+from typing import Final, NamedTuple, Union
 
 
 class _TextEnum(str, Enum):
@@ -74,8 +73,7 @@ class ServoName(_TextEnum):
     BOTH = "both"
 
 
-@dataclass(frozen=True)
-class ChannelLimits:
+class ChannelLimits(NamedTuple):
     """One RC channel of Table 4: recorded extremes and the derived speeds (µs)."""
 
     name: ChannelName
@@ -96,8 +94,7 @@ CHANNELS: Final[Mapping[str, ChannelLimits]] = MappingProxyType({
 })
 
 
-@dataclass(frozen=True)
-class ServoLimits:
+class ServoLimits(NamedTuple):
     name: ServoName
     minimum: int
     maximum: int
@@ -298,8 +295,7 @@ LASER_ON_CODE: Final = "1"
 LASER_OFF_CODE: Final = "0"
 
 
-@dataclass(frozen=True)
-class CommandSpec:
+class CommandSpec(NamedTuple):
     """What the spec says of one command."""
 
     name: CommandName
