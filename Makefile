@@ -9,9 +9,12 @@ PY := $(VENV)/bin/python
 VENV_STAMP := $(VENV)/.installed
 APT_STAMP := build/.apt-packages
 
-# Debian 12 packages: the AVR toolchain and Arduino core, simavr, host compilers, clang + libFuzzer, valgrind.
+# Debian 12 packages: the AVR toolchain and Arduino core, arduino-builder (the IDE's builder) and avrdude,
+# simavr, host compilers, clang + libFuzzer, valgrind, Chromium and its WebDriver (the browser tests).
 APT_PACKAGES := make gcc g++ python3 python3-venv python3-pip gcc-avr binutils-avr avr-libc arduino-core-avr \
-                simavr libsimavr-dev libelf-dev pkg-config clang libclang-rt-14-dev valgrind
+                arduino-builder avrdude \
+                simavr libsimavr-dev libelf-dev pkg-config clang libclang-rt-14-dev valgrind \
+                chromium chromium-driver
 
 .PHONY: all demo test deps generate check-generated lint typecheck pytest fuzz fuzz-smoke bench clean
 
@@ -19,7 +22,7 @@ all: generate
 
 deps: $(APT_STAMP) $(VENV_STAMP)
 
-$(APT_STAMP):
+$(APT_STAMP): Makefile  # a package added here is installed on the next run
 	@missing=$$(for p in $(APT_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null \
 	    | grep -q "install ok installed" || echo $$p; done); \
 	if [ -n "$$missing" ]; then \
@@ -32,10 +35,14 @@ $(APT_STAMP):
 	fi
 	@mkdir -p $(dir $@) && touch $@
 
-$(VENV_STAMP): pyproject.toml
+# The codec (generated/python, its own distribution) first, then the project, which depends on it; both editable.
+$(VENV_STAMP): pyproject.toml setup.py generated/python/pyproject.toml
 	@test -x $(PY) || $(PYTHON_SYSTEM) -m venv $(VENV)
-	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e '.[dev]'
+	@echo "Installing the Python environment in $(VENV) (the codec, the project and its dev tools)"
+	@mkdir -p build
+	@# pip's and setuptools' chatter goes to a log, shown only when the install fails
+	@{ $(PY) -m pip install -q --upgrade pip && $(PY) -m pip install -q -e generated/python -e '.[dev]'; } \
+	  >build/pip-install.log 2>&1 || { cat build/pip-install.log; echo "pip install failed (log: build/pip-install.log)"; exit 1; }
 	@touch $@
 
 generate: $(VENV_STAMP)
@@ -48,7 +55,7 @@ lint: $(VENV_STAMP)
 	$(VENV)/bin/ruff check --output-format concise .
 
 typecheck: $(VENV_STAMP)
-	$(VENV)/bin/mypy --strict generator generated/python/drone_protocol pilot tests bench
+	$(VENV)/bin/mypy --strict generator generated/python/drone_protocol pilot tests bench firmware/ide
 
 pytest: deps
 	$(PY) -m pytest -q tests
@@ -63,6 +70,8 @@ demo: deps generate
 -include pilot/pilot.mk
 -include tests/fuzz/fuzz.mk
 -include bench/bench.mk
+-include tests/targets/targets.mk
+-include tests/targets/typescript.mk
 
 clean:
 	rm -rf build firmware/build

@@ -3,21 +3,41 @@
 #   make bench-protocol   Python codec vs f-string/slice floors, C++ StreamParser throughput and instructions per
 #                         frame, parser flash/RAM on the ATmega328P, generator run time; writes
 #                         bench/protocol/RESULTS.md
-#   make bench            every part's benchmark: bench-protocol, bench-firmware (firmware/firmware.mk) and
-#                         bench-pilot (pilot/pilot.mk)
+#   make bench-generator  generator time for the shipped and a 676-command spec, rejecting hostile specs;
+#                         writes bench/generator/RESULTS.md
+#   make bench-vision     the detectors on real photographs (scikit-image's) under 10 conditions, empty and
+#                         distractor views, tuning and held-out photos, time vs the cvtColor+inRange floor;
+#                         writes bench/vision/RESULTS.md (BENCH_VISION_FLAGS=--quick for a smoke run)
+#   make bench-tools      the standalone codec wheel's size and import time vs json; the live view's frame
+#                         latency and the pilot loop's rate with and without a viewer; writes bench/tools/RESULTS.md
+#   make bench            every part's benchmark: bench-protocol, bench-generator, bench-firmware
+#                         (firmware/firmware.mk), bench-pilot (pilot/pilot.mk), bench-vision, bench-ide
+#                         (bench/ide/bench.mk), bench-rust-c (tests/targets/targets.mk) and bench-tools
 #
 # BENCH_PROTOCOL_FLAGS=--quick for a smoke run (fewer repetitions; still writes RESULTS.md unless --no-write).
 
 BENCH_PROTOCOL_BUILD ?= build/bench/protocol
 BENCH_PROTOCOL_FLAGS ?=
 
-.PHONY: bench bench-protocol bench-firmware bench-pilot
+BENCH_VISION_FLAGS ?=
+
+.PHONY: bench bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-ide bench-tools
 
 # Run benchmarks one at a time (not with make -j): they time each other otherwise.
-bench: bench-protocol bench-firmware bench-pilot
+bench: bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-ide bench-rust-c bench-tools
+
+bench-vision: deps
+	PYTHONPATH=.:bench/vision $(PY) bench/vision/run.py $(BENCH_VISION_FLAGS)
 
 bench-protocol: deps
 	$(PY) bench/protocol/run.py --build $(BENCH_PROTOCOL_BUILD) $(BENCH_PROTOCOL_FLAGS)
+
+bench-generator: deps
+	$(PY) -m bench.generator.run
+
+BENCH_TOOLS_FLAGS ?=
+bench-tools: deps firmware-host
+	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.tools.run $(BENCH_TOOLS_FLAGS)
 
 # Recipes come from firmware/firmware.mk and pilot/pilot.mk; a part that has none yet benchmarks nothing.
 bench-firmware bench-pilot:

@@ -23,7 +23,7 @@ AVR_SIZE ?= avr-size
 HOST_CXX ?= g++
 HOST_CC ?= gcc
 
-FW_SKETCH_SRC := $(FW_DIR)/drone/drone_app.cpp $(FW_DIR)/drone/drone_logic.cpp \
+FW_SKETCH_SRC := $(FW_DIR)/drone/drone_app.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_DIR)/drone/drone_handlers.cpp \
                  $(FW_DIR)/drone/pulse_schedule.cpp $(FW_DIR)/drone/pulse_out_avr.cpp
 FW_HEADERS := $(wildcard $(FW_DIR)/drone/*.h)
 FW_PROTO_SRC = $(wildcard $(DRONE_PROTOCOL_DIR)/src/*.cpp)
@@ -67,6 +67,8 @@ endef
 
 $(eval $(call fw_core,uno,atmega328p,standard,AVR_UNO))
 $(eval $(call fw_core,mega,atmega2560,mega,AVR_MEGA2560))
+# Linker relaxation (call -> rcall where it reaches) on the Mega 2560, as the Arduino IDE links it.
+FW_CORE_mega_LDFLAGS := -Wl,--relax
 
 # $(call fw_board,NAME,CORE_KEY,EXTRA_DEFINES,SKETCH_SOURCES)
 # Builds $(FW_BUILD)/NAME/NAME.elf/.hex from a core and the sources.
@@ -81,7 +83,7 @@ $$(FW_$(1)_DIR)/$(1).elf: $(4) $$(FW_HEADERS) $$(FW_PROTO_SRC) $$(FW_PROTO_HDR) 
 	@mkdir -p $$(@D)
 	@test -f $$(DRONE_PROTOCOL_DIR)/src/DroneProtocol.h || { echo "missing $$(DRONE_PROTOCOL_DIR)/src/DroneProtocol.h: run the generator first" >&2; exit 1; }
 	@echo "  LD    $$@"
-	@$$(AVR_CXX) $$(FW_$(1)_FLAGS) $$(FW_AVR_CXXFLAGS) $$(FW_WARN) -fuse-linker-plugin -Wl,--gc-sections \
+	@$$(AVR_CXX) $$(FW_$(1)_FLAGS) $$(FW_AVR_CXXFLAGS) $$(FW_WARN) -fuse-linker-plugin -Wl,--gc-sections $$(FW_CORE_$(2)_LDFLAGS) \
 	  -I$$(DRONE_PROTOCOL_DIR)/src -I$$(FW_DIR)/drone \
 	  -x c++ -include Arduino.h $$(filter %.ino,$(4)) -x none $$(filter-out %.ino,$(4)) $$(FW_PROTO_SRC) \
 	  $$(FW_CORE_$(2)_DIR)/core.a -lm -o $$@
@@ -100,16 +102,23 @@ FW_HEXES := $(FW_ELVES:.elf=.hex)
 .PHONY: firmware firmware-uno firmware-host firmware-sim firmware-clean bench-firmware
 # $(APT_STAMP) (top-level Makefile) installs the toolchain on a fresh machine.
 firmware: $(APT_STAMP) $(FW_HEXES) firmware-host firmware-sim
-	@$(AVR_SIZE) -C --mcu=atmega328p $(FW_BUILD)/uno/uno.elf | grep -E 'Program|Data' | sed 's/^/uno:      /'
-	@$(AVR_SIZE) -C --mcu=atmega328p $(FW_BUILD)/uno_ppm/uno_ppm.elf | grep -E 'Program|Data' | sed 's/^/uno ppm:  /'
-	@$(AVR_SIZE) -C --mcu=atmega2560 $(FW_BUILD)/mega/mega.elf | grep -E 'Program|Data' | sed 's/^/mega:     /'
+	@$(call fw_report,uno,atmega328p)
+	@$(call fw_report,uno_ppm,atmega328p)
+	@$(call fw_report,mega,atmega2560)
+	@echo "Flash one: make upload PORT=/dev/ttyACM0 BOARD=uno|mega|uno_ppm"
+
+# $(call fw_report,NAME,MCU): the .hex to flash, its flash and RAM use.
+fw_report = $(AVR_SIZE) -C --mcu=$(2) $(FW_BUILD)/$(1)/$(1).elf | awk -v b=$(1) -v hex=$(FW_BUILD)/$(1)/$(1).hex \
+  '/^Program:/ {f = $$2; fp = $$4} /^Data:/ {d = $$2; dp = $$4} \
+   END {printf "%-8s %s  flash %d B %s full), RAM %d B %s full)\n", b, hex, f, fp, d, dp}'
 
 firmware-uno: $(FW_BUILD)/uno/uno.hex
 
 # --- host build ---------------------------------------------------------------
 FW_HOST_DIR := $(FW_BUILD)/host
 FW_HOST_FLAGS := -std=c++11 -O1 -g -fsanitize=address,undefined -fno-sanitize-recover=all $(FW_WARN) -I$(FW_DIR)/host -I$(FW_DIR)/drone -I$(DRONE_PROTOCOL_DIR)/src
-FW_HOST_LOGIC := $(FW_DIR)/drone/drone_app.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_DIR)/drone/pulse_schedule.cpp \
+FW_HOST_LOGIC := $(FW_DIR)/drone/drone_app.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_DIR)/drone/drone_handlers.cpp \
+                 $(FW_DIR)/drone/pulse_schedule.cpp \
                  $(FW_DIR)/host/pulse_out_host.cpp $(FW_DIR)/host/fake_arduino.cpp
 FW_HOST_DEPS = $(FW_HEADERS) $(wildcard $(FW_DIR)/host/*.h) $(FW_PROTO_SRC) $(FW_PROTO_HDR)
 
@@ -124,7 +133,8 @@ $(FW_HOST_DIR)/pulse_schedule_test: $(FW_DIR)/host/pulse_schedule_test.cpp $(FW_
 	@$(HOST_CXX) $(FW_HOST_FLAGS) $(filter %.cpp,$^) -o $@
 
 # libFuzzer target over the whole logic (clang, from the toolchain stamp).
-$(FW_HOST_DIR)/fuzz_drone: $(FW_DIR)/host/fuzz_drone.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_HEADERS) $(FW_PROTO_HDR)
+$(FW_HOST_DIR)/fuzz_drone: $(FW_DIR)/host/fuzz_drone.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_DIR)/drone/drone_handlers.cpp \
+                           $(FW_HEADERS) $(FW_PROTO_HDR)
 	@mkdir -p $(@D)
 	@echo "  CXX   $@"
 	@clang++ -std=c++11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all $(FW_WARN) \
@@ -144,3 +154,4 @@ firmware-clean:
 	rm -rf $(FW_BUILD)
 
 -include bench/firmware/bench.mk
+-include $(FW_DIR)/ide/ide.mk

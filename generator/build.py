@@ -8,13 +8,15 @@ import json
 from pathlib import Path
 from typing import TypeVar
 
-from generator import __version__
-from generator.errors import SpecError, SpecInvalid
-from generator.model import INTEGRITY_MODES, Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
-from generator.names import identifier_problem
-from generator.reader import Reader, is_int, kind_name
-from generator.source import INVALID, Node, load
-from generator.status import read_status
+from . import __version__, hardware
+from .diff import Contract, contract, version_problem
+from .errors import SpecError, SpecInvalid
+from .model import INTEGRITY_MODES, Category, Channel, Direction, ErrorKind, Field, Reply, Servo, Settled, Spec
+from .names import identifier_problem, protocol_name_problem, safe_file_name
+from .reader import Reader, is_int, kind_name
+from .source import INVALID, Node, display_path, load, read
+from .status import read_status
+from .widths import overflows
 
 T = TypeVar("T")
 
@@ -36,19 +38,24 @@ def fingerprint(value: object) -> str:
     return hashlib.sha256(canonical.encode("ascii")).hexdigest()
 
 
-def load_spec(path: Path) -> Spec:
-    """Read, validate and build the model of the spec at `path`; raise SpecInvalid with every error."""
-    name = path.name
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        from generator.errors import Location
+def load_spec(path: Path, previous: Contract | None = None) -> Spec:
+    """Read, validate and build the model of the spec at `path`; raise SpecInvalid with every error.
 
-        raise SpecInvalid([SpecError(Location(str(path), 1, 1), "", f"cannot read the spec: {exc}")]) from exc
-    root, errors = load(text, str(path))
+    `previous`: the contract generated last; the spec's version must rise if it breaks that contract."""
+    text, errors = read(path)
+    if text is None:
+        raise SpecInvalid(errors)
+    root, errors = load(text, display_path(path))
     if root is None:
         raise SpecInvalid(errors)
-    spec = _Builder(root, name, errors).build()
+    builder = _Builder(root, safe_file_name(path), errors)
+    spec = builder.build()
+    if spec is not None and previous is not None:
+        problem = version_problem(previous, contract(spec))
+        if problem:
+            errors.append(SpecError(builder.node_at("protocol.version").location, "protocol.version", problem,
+                                    "raise protocol.version (`python -m generator diff` lists the changes); "
+                                    "to undo a generated edit, restore generated/ too (git checkout generated)"))
     if errors or spec is None:
         raise SpecInvalid(errors)
     return spec
@@ -70,7 +77,7 @@ class _Builder:
         speeds = top.section("speeds")
 
         name = protocol.text("name")
-        self._identifier(protocol, "name", name)
+        self._identifier(protocol, "name", name, protocol=True)
         version = protocol.integer("version")
         title = protocol.text("title")
         description = protocol.text("description")
@@ -128,10 +135,11 @@ class _Builder:
         errors = self._errors(top)
         status = read_status(top, self.errors)
         settled = self._settled(top)
+        project, wiring = hardware.read(top, channels, list(servos), failsafe_throttle, (stabilize, alt_hold))
         top.finish()
         if self.errors:
             return None
-        return Spec(
+        spec = Spec(
             source_name=self.source_name,
             fingerprint=fingerprint(self.root.value),
             generator_version=__version__,
@@ -163,7 +171,22 @@ class _Builder:
             errors=tuple(errors),
             status=status,
             settled=tuple(settled),
+            project=project,
+            wiring=wiring,
         )
+        for path, message in overflows(spec):
+            node = self.node_at(path)
+            self.errors.append(SpecError(node.location, path, message, "the generated C++ would hold another number"))
+        return None if self.errors else spec
+
+    def node_at(self, path: str) -> Node:
+        """The node the spec writes at dotted `path` (or its nearest parent that exists)."""
+        node = self.root
+        for key in path.split("."):
+            if key not in node.children:
+                break
+            node = node.children[key]
+        return node
 
     # -- helpers -------------------------------------------------------------------------------------------
 
@@ -174,11 +197,12 @@ class _Builder:
             reader.error(node, f"{key} must be positive, found {value}", path=reader.sub(key))
         return value
 
-    def _identifier(self, reader: Reader, key: str, name: str, python_only: bool = False) -> bool:
+    def _identifier(self, reader: Reader, key: str, name: str, python_only: bool = False,
+                    protocol: bool = False) -> bool:
         node = reader.node.children.get(key) if reader.ok else None
         if node is None or not name:
             return False
-        problem = identifier_problem(name, python_only)
+        problem = protocol_name_problem(name) if protocol else identifier_problem(name, python_only)
         if problem:
             reader.error(node, problem, "names become Python and C++ identifiers", reader.sub(key))
             return False

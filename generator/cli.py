@@ -1,47 +1,121 @@
-"""Command line: regenerate every target, or check that generated/ matches the spec."""
+"""Command line: regenerate every target, check that generated/ matches the spec, or diff two spec versions.
+
+  python -m generator [--spec FILE] [--out DIR] [--check]
+  python -m generator diff OLD [NEW]     (OLD, NEW: a spec, or a generated contract.json; NEW: spec/drone.yaml)
+"""
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
-from generator import __version__
-from generator.build import load_spec
-from generator.errors import SpecInvalid
-from generator.render import render_all, stale_files, write_atomically
+from . import __version__
+from .build import load_spec
+from .diff import Contract, contract, diff
+from .errors import SpecInvalid
+from .source import display_path
 
 EXIT_STALE = 1
+EXIT_BREAKING = 1
 EXIT_INVALID = 2
+CONTRACT_FILE = "contract.json"
+# Relative to the current folder: the repository's layout. An installed generator run elsewhere needs --spec.
+DEFAULT_SPEC = Path("spec/drone.yaml")
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m generator", description=__doc__)
-    parser.add_argument("--spec", type=Path, default=Path("spec/drone.yaml"),
-                        help="the YAML spec (default: %(default)s)")
+    args = sys.argv[1:] if argv is None else argv
+    if args[:1] == ["diff"]:
+        return diff_main(args[1:])
+    parser = argparse.ArgumentParser(prog="python -m generator", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--spec", type=Path, help=f"the YAML spec (default: {DEFAULT_SPEC} in the current folder)")
     parser.add_argument("--out", type=Path, default=Path("generated"), help="output folder (default: %(default)s)")
     parser.add_argument("--check", action="store_true", help="write nothing; exit 1 listing stale or missing files")
-    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
-    args = parser.parse_args(argv)
+    parser.add_argument("--version", action="store_true", help="print the generator's version and the spec's "
+                        "fingerprint, then exit")
+    opts = parser.parse_args(args)
+    if opts.spec is None:
+        if not DEFAULT_SPEC.is_file():
+            if opts.version:
+                print(f"{parser.prog} {__version__} (no spec: {DEFAULT_SPEC} is not in the current folder)")
+                return 0
+            print(f"{parser.prog}: error: no spec given and no {DEFAULT_SPEC} in the current folder: "
+                  "pass --spec FILE", file=sys.stderr)
+            return EXIT_INVALID
+        opts.spec = DEFAULT_SPEC
+    shown = display_path(opts.spec)
     try:
-        spec = load_spec(args.spec)
+        spec = load_spec(opts.spec, previous=_previous_contract(opts.out / CONTRACT_FILE))
     except SpecInvalid as exc:
-        count = len(exc.errors)
-        print(f"{args.spec}: {count} error{'s' if count != 1 else ''}; nothing was written", file=sys.stderr)
-        for error in exc.errors:
-            print(error, file=sys.stderr)
+        _report(shown, exc)
         return EXIT_INVALID
+    if opts.version:
+        print(f"{parser.prog} {__version__} (spec {shown}: {spec.name} {spec.version}, "
+              f"fingerprint {spec.short_fingerprint})")
+        return 0
+    from .render import render_all, stale_files, write_atomically  # Jinja only for a valid spec
+
     files = render_all(spec)
-    if args.check:
-        problems = stale_files(files, args.out)
+    if opts.check:
+        problems = stale_files(files, opts.out)
         for line in problems:
             print(line)
         if problems:
             print(f"{len(problems)} generated file(s) out of date: run `python -m generator`", file=sys.stderr)
             return EXIT_STALE
-        print(f"{len(files)} generated files match {args.spec} (fingerprint {spec.short_fingerprint})")
+        print(f"{len(files)} generated files match {shown} (fingerprint {spec.short_fingerprint})")
         return 0
-    changed = write_atomically(files, args.out)
-    print(f"{len(files)} files from {args.spec} (fingerprint {spec.short_fingerprint}) in {args.out}/: "
+    changed = write_atomically(files, opts.out)
+    print(f"{len(files)} files from {shown} (fingerprint {spec.short_fingerprint}) in {display_path(opts.out)}/: "
           f"{len(changed)} changed")
     return 0
+
+
+def diff_main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m generator diff",
+        description="List what changed between two versions of the protocol; exit 1 if a change breaks a peer "
+                    "built from OLD, 2 if a spec is invalid.")
+    parser.add_argument("old", type=Path, help="the old spec, or a generated contract.json")
+    parser.add_argument("new", type=Path, nargs="?", default=DEFAULT_SPEC, help="the new spec (default: %(default)s)")
+    opts = parser.parse_args(argv)
+    try:
+        old, new = _contract_of(opts.old), _contract_of(opts.new)
+    except SpecInvalid as exc:
+        _report(display_path(exc.errors[0].location.file) if exc.errors else "spec", exc)
+        return EXIT_INVALID
+    changes = diff(old, new)
+    for change in changes:
+        print(change)
+    breaks = sum(c.breaking for c in changes)
+    version = f"version {old.get('version')} -> {new.get('version')}"
+    if breaks and new.get("version", 0) <= old.get("version", 0):
+        version += ": the version must rise"
+    print(f"{breaks} breaking, {len(changes) - breaks} compatible change{'s' if len(changes) - breaks != 1 else ''}"
+          f" ({version})")
+    return EXIT_BREAKING if breaks else 0
+
+
+def _report(shown: str, exc: SpecInvalid) -> None:
+    count = len(exc.errors)
+    print(f"{shown}: {count} error{'s' if count != 1 else ''}; nothing was written", file=sys.stderr)
+    for error in exc.errors:
+        print(error, file=sys.stderr)
+
+
+def _previous_contract(file: Path) -> Contract | None:
+    """The contract in a generated contract.json, if it is there and readable (else there is nothing to compare)."""
+    try:
+        data = json.loads(file.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    found = data.get("contract") if isinstance(data, dict) else None
+    return found if isinstance(found, dict) and isinstance(found.get("version"), int) else None
+
+
+def _contract_of(path: Path) -> Contract:
+    found = _previous_contract(path) if path.suffix == ".json" else None
+    return found if found is not None else contract(load_spec(path))

@@ -2,12 +2,25 @@
 
 from __future__ import annotations
 
+import html
 import json
 import textwrap
 from collections.abc import Callable
 from typing import Any
 
-from generator.names import pascal
+from .model import check_text
+from .names import pascal
+
+
+class Safe(str):
+    """Text a filter already made safe for its target (e.g. Markdown code): not escaped again."""
+
+
+def html_text(value: object) -> object:
+    """Jinja's finalize for Markdown: spec text never becomes HTML (`<img onerror=...>` prints as text)."""
+    if isinstance(value, str) and not isinstance(value, Safe):
+        return html.escape(value, quote=False)
+    return value
 
 
 def cpp_char(code: str) -> str:
@@ -35,13 +48,46 @@ def docstring(text: str) -> str:
     return text.replace("\\", "\\\\").replace('"', '\\"')
 
 
+# -- Rust and C99 targets -------------------------------------------------------------------------------------
+RUST_KEYWORDS = frozenset(
+    """as async await break const continue crate dyn else enum extern false fn for if impl in let loop match mod
+    move mut pub ref return static struct trait true type unsafe use where while abstract become box do final
+    macro override priv try typeof unsized virtual yield gen""".split()
+)
+
+
+def rust_ident(name: str) -> str:
+    """A Rust identifier for a spec name: a keyword becomes a raw identifier (`r#move`)."""
+    return f"r#{name}" if name in RUST_KEYWORDS else name
+
+
+def rust_byte(code: str) -> str:
+    """A Rust byte literal for one ASCII character."""
+    return "b'\\''" if code == "'" else "b'\\\\'" if code == "\\" else f"b'{code}'"
+
+
+def rust_string(text: str) -> str:
+    """A Rust string literal of printable ASCII text (and newlines)."""
+    return cpp_string(text)
+
+
+def check_hex(text: str) -> str:
+    """The crc8 integrity check of ASCII text, as the two hex digits the wire carries."""
+    return check_text(text.encode("ascii"))
+
+
+def initials(name: str) -> str:
+    """The C99 target's prefix of a snake_case name: drone_protocol -> dp."""
+    return "".join(part[0] for part in name.split("_") if part)
+
+
 def md_cell(text: str) -> str:
     return text.replace("|", "\\|")
 
 
 def md_code(text: str) -> str:
     """Inline Markdown code that survives backticks and surrounding spaces."""
-    return f"`` {text} ``" if "`" in text or text != text.strip() else f"`{text}`"
+    return Safe(f"`` {text} ``" if "`" in text or text != text.strip() else f"`{text}`")
 
 
 def frame_text(frame: bytes) -> str:
@@ -60,6 +106,11 @@ ALL: dict[str, Callable[..., Any]] = {
     "py_string": py_string,
     "py_bytes": py_bytes,
     "docstring": docstring,
+    "rust_ident": rust_ident,
+    "rust_byte": rust_byte,
+    "rust_string": rust_string,
+    "initials": initials,
+    "check_hex": check_hex,
     "md_cell": md_cell,
     "md_code": md_code,
     "pascal": pascal,
@@ -67,4 +118,5 @@ ALL: dict[str, Callable[..., Any]] = {
     "frame_text": frame_text,
     "wrap": wrap,
     "tojson": lambda v: json.dumps(v, sort_keys=True),
+    "add_suffix": lambda text, suffix: f"{text}{suffix}",
 }

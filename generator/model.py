@@ -160,6 +160,36 @@ class Vector:
 
 
 @dataclass(frozen=True)
+class Project:
+    """Who publishes the generated library and packages (spec section `project`)."""
+
+    author: str
+    maintainer: str
+    url: str
+
+
+@dataclass(frozen=True)
+class WiredPin:
+    name: str  # a channel name or "mode" (RC outputs), a servo name, "laser" or "ppm"
+    pin: int  # Arduino pin number
+    rc_input: int  # 1-based flight-controller input (RC channel), 0 for outputs that are not RC
+
+
+@dataclass(frozen=True)
+class Wiring:
+    """Where the firmware's outputs leave the Arduino (spec section `wiring`)."""
+
+    rc_inputs: tuple[WiredPin, ...]  # in the flight controller's input order
+    servos: tuple[WiredPin, ...]
+    laser: WiredPin
+    ppm: WiredPin
+
+    def rc_input(self, name: str) -> int:
+        """The flight-controller input an RC output is wired to, 0 when the spec wires none of that name."""
+        return next((p.rc_input for p in self.rc_inputs if p.name == name), 0)
+
+
+@dataclass(frozen=True)
 class Spec:
     source_name: str
     fingerprint: str  # sha256 of the canonical spec, hex
@@ -192,6 +222,13 @@ class Spec:
     errors: tuple[ErrorKind, ...]
     status: Status
     settled: tuple[Settled, ...]
+    project: Project
+    wiring: Wiring
+
+    @property
+    def package_version(self) -> str:
+        """protocol.version as the version of the generated library and packages (semantic: N -> N.0.0)."""
+        return f"{self.version}.0.0"
 
     @property
     def short_fingerprint(self) -> str:
@@ -208,6 +245,14 @@ class Spec:
     @property
     def category_lookup(self) -> ByteLookup:
         return _lookup({ord(c.code): i for i, c in enumerate(self.categories)})
+
+    # --- C++ parser tables (firmware helper) ---
+    @property
+    def direction_lookups(self) -> tuple[ByteLookup, ...]:
+        """Per category: its direction bytes to the index within the category + 1 (0: none), for the C++
+        parser's constant-time byte-1 lookup."""
+        return tuple(_lookup({ord(d.code): i for i, d in enumerate(c.directions)}) for c in self.categories)
+    # --- end of C++ parser tables ---
 
     @property
     def category_ranges(self) -> tuple[tuple[int, int], ...]:
@@ -227,6 +272,15 @@ class Spec:
         return next(r for r in self.replies if r.name == name)
 
     @property
+    def reply_max_length(self) -> int:
+        """The longest reply line in bytes, "\n" included: `READY name fingerprint16 integrity`, or a prefix, two
+        bytes (category and direction, or an error code) and the status; each with "*XX" in crc8 mode."""
+        check = 1 + self.check_length if self.check_length else 0
+        ready = (len(self.reply("ready").prefix) + 1 + len(self.name) + 1 + len(self.short_fingerprint) + 1
+                 + len(self.integrity) + check + 1)
+        return max(ready, max(len(r.prefix) for r in self.replies) + 2 + self.status.length + check + 1)
+
+    @property
     def digits_width(self) -> int:
         return self.frame_length - 2
 
@@ -241,6 +295,13 @@ class Spec:
 
     def error(self, name: str) -> ErrorKind:
         return next(e for e in self.errors if e.name == name)
+
+    def wire(self, text: str) -> str:
+        """A frame or reply line as it goes on the wire: with its check in crc8 mode (a reply's after '*')."""
+        if self.integrity == "none":
+            return text
+        data = text.encode("ascii")
+        return text + check_text(data) if len(data) == self.frame_length else text + "*" + check_text(data)
 
 
 # frame.integrity modes and the check characters each appends to a frame.

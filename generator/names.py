@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import keyword
 import re
+import sys
+from pathlib import Path
 
 IDENTIFIER = re.compile(r"^[a-z][a-z0-9]*(_[a-z0-9]+)*$")
 
@@ -37,6 +39,16 @@ GENERATED_NAMES = frozenset(
     dataclass annotations detail""".split()
 ) | PYTHON_BUILTINS_USED
 
+MAX_NAME = 40  # a name becomes a file name, a C++ macro prefix and a Python identifier: keep it readable
+
+# The protocol's name is also a Python package (it must not shadow a standard module: `import os` would
+# load the generated codec), a C++ namespace and, in PascalCase, an Arduino library and its header file
+# (it must not replace the core's or a bundled library's header).
+PROTOCOL_RESERVED = frozenset(sys.stdlib_module_names) | frozenset(
+    """std posix detail arduino eeprom hid keyboard mouse servo software_serial spi wire stepper ethernet sd
+    generator pilot drone_sim""".split()
+)
+
 RESERVED = frozenset(keyword.kwlist) | frozenset(keyword.softkwlist) | CPP_KEYWORDS | ARDUINO_MACROS
 
 
@@ -44,6 +56,8 @@ def identifier_problem(name: str, python_only: bool = False) -> str | None:
     """Why `name` cannot be used as a generated identifier, or None.
 
     `python_only` is for names printed only into Python (argument names: C++ takes a `value`)."""
+    if len(name) > MAX_NAME:
+        return f"'{name[:MAX_NAME]}...' is longer than {MAX_NAME} characters"
     if not IDENTIFIER.match(name):
         return f"'{name}' is not a lower_snake_case identifier (letters, digits, single underscores)"
     if python_only:
@@ -55,9 +69,26 @@ def identifier_problem(name: str, python_only: bool = False) -> str | None:
     return None
 
 
+def protocol_name_problem(name: str) -> str | None:
+    """Why `name` cannot name the protocol (its Python package, C++ namespace and Arduino library), or None."""
+    problem = identifier_problem(name)
+    if problem is None and name in PROTOCOL_RESERVED:
+        problem = f"'{name}' would shadow a standard Python module or an Arduino library of that name"
+    return problem
+
+
 def pascal(name: str) -> str:
     return "".join(part.capitalize() for part in name.split("_"))
 
 
 def upper(name: str) -> str:
     return name.upper()
+
+
+_UNSAFE_IN_NAME = re.compile(r"[^A-Za-z0-9._+-]|-(?=-)")
+
+
+def safe_file_name(path: Path) -> str:
+    """The spec's base name as printed into generated files: only characters inert in every target's comments
+    and strings (no newline, quote, `*/`, `-->`); anything else becomes '_'."""
+    return _UNSAFE_IN_NAME.sub("_", path.name)[:64] or "spec"

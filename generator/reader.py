@@ -6,12 +6,13 @@ import difflib
 import re
 from typing import TypeVar
 
-from generator.errors import SpecError
-from generator.source import INVALID, Node
+from .errors import SpecError
+from .source import INVALID, Node
 
 T = TypeVar("T")
 
 _BAD_TEXT = re.compile(r"[\x00-\x1f\x7f\\]|\?\?|\"\"\"")
+MAX_TEXT = 2000  # characters of one text value: a paragraph (and wrapping it stays instant)
 
 
 class Reader:
@@ -96,9 +97,13 @@ class Reader:
 
 
 def text_problem(value: str) -> str | None:
+    if len(value) > MAX_TEXT:
+        return f"text of {len(value)} characters is longer than {MAX_TEXT}"
     bad = _BAD_TEXT.search(value.replace("\n", " "))
     if bad is None:
-        return None
+        # Unicode format and separator characters (bidi overrides, U+2028...) can hide or reorder code
+        hidden = next((c for c in value if not c.isprintable() and c != "\n"), None)
+        return None if hidden is None else f"text contains U+{ord(hidden):04X}, an invisible or control character"
     return f"text contains {bad.group()!r}, which could break out of a comment or string in generated code"
 
 

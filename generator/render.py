@@ -9,12 +9,14 @@ from pathlib import Path
 
 import jinja2
 
-from generator import filters
-from generator.build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
-from generator.model import Spec
-from generator.names import pascal
-from generator.targets import TARGETS, Target
-from generator.vectors import build_vectors
+from . import ardupilot, filters
+from .build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
+from .diff import contract
+from .model import Spec
+from .names import pascal
+from .targets import TARGETS, Target, comment_style
+from .vectors import build_vectors
+from .widths import CTYPES
 
 TEMPLATES = Path(__file__).parent / "templates"
 
@@ -27,13 +29,14 @@ def header_lines(spec: Spec) -> list[str]:
     ]
 
 
-def _with_header(target: Target, text: str, spec: Spec) -> str:
+def _with_header(path: str, text: str, spec: Spec) -> str:
     lines = header_lines(spec)
-    if target.comment == "json":
+    style = comment_style(path)
+    if style == "json":
         return text  # JSON has no comments: its template prints the header as its first member
-    if target.comment == "<!--":
+    if style == "<!--":
         return "<!--\n" + "\n".join(lines) + "\n-->\n" + text
-    return "".join(f"{target.comment} {line}\n" for line in lines) + text
+    return "".join(f"{style} {line}\n" for line in lines) + text
 
 
 def _environment(target: Target) -> jinja2.Environment:
@@ -45,6 +48,8 @@ def _environment(target: Target) -> jinja2.Environment:
         keep_trailing_newline=True,
         autoescape=False,
     )
+    if target.escape == "html":
+        env.finalize = filters.html_text
     env.filters.update(filters.ALL)
     return env
 
@@ -55,16 +60,19 @@ def render_all(spec: Spec) -> dict[str, bytes]:
     context = {
         "spec": spec,
         "vectors": build_vectors(spec),
+        "ardupilot": ardupilot.parameters(spec),
         "header": header_lines(spec),
         "header_json": json.dumps(
             {"notice": header_lines(spec)[0], "fingerprint": spec.fingerprint, "spec": spec.source_name,
              "generator": spec.generator_version}, sort_keys=True),
         "library": pascal(spec.name),
         "frame_errors": FRAME_ERRORS,
+        "raised_errors": (*FRAME_ERRORS, "bad_check"),  # the error kinds decode() raises as exceptions
         "parser_error_count": sum(1 for e in spec.errors if e.name in PARSER_ERRORS),
         "stream_error_count": len(STREAM_ERRORS),
-        "reply_max_length": max(len(spec.reply("ready").prefix) + len(spec.name) + 19,
-                                max(len(r.prefix) for r in spec.replies) + 3),
+        "reply_max_length": spec.reply_max_length,
+        "contract_json": json.dumps(contract(spec), indent=2, sort_keys=True).replace("\n", "\n  "),
+        "ctype": CTYPES,
     }
     files: dict[str, bytes] = {}
     for target in TARGETS:
@@ -79,7 +87,7 @@ def render_all(spec: Spec) -> dict[str, bytes]:
             for placeholder, value in names.items():
                 out = out.replace(placeholder, value)
             path = f"{target.out_dir}/{out}" if target.out_dir else out
-            files[path] = _with_header(target, text, spec).encode("utf-8")
+            files[path] = (text if target.own_header else _with_header(path, text, spec)).encode("utf-8")
     return files
 
 

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from generator.errors import SpecError
-from generator.model import Status, StatusState
-from generator.names import identifier_problem
-from generator.reader import Reader
+from .errors import SpecError
+from .model import Status, StatusState
+from .names import identifier_problem
+from .reader import Reader
 
 # The firmware's state machine reports each of these; a spec must give every one a code.
 STATES = ("disarmed", "arming", "armed", "hold_altitude", "moving", "landing", "disarming", "self_test", "failsafe")

@@ -19,19 +19,23 @@ from types import FrameType
 
 import drone_protocol as dp
 
-from pilot import config as config_mod
-from pilot.calibrate import Roi, calibrate_to_config
-from pilot.config import PilotConfig
-from pilot.controller import Controller, State
-from pilot.detect import make_detector
-from pilot.errors import PilotError
-from pilot.link import Link, LogEntry, keepalive_ms
-from pilot.record import Recorder
-from pilot.runner import DryRunSink, Observer, RealPacer, Sink, StatusLine, run
-from pilot.sim.camera import CameraModel, CameraPose, Renderer
-from pilot.sim.flight import fly
-from pilot.sim.room import SCENARIOS, make_scenario
-from pilot.sources import CameraSource, Frame, FrameSource, ImageFolderSource, VideoFileSource
+from . import __version__
+from . import config as config_mod
+from .calibrate import Roi, calibrate_to_config, preview_path
+from .cli_options import LiveSession, check_sources, port_error_hint, stop_note
+from .config import PilotConfig
+from .controller import Controller, State
+from .detect import make_detector
+from .errors import PilotError
+from .link import Link, LogEntry, keepalive_ms
+from .observers import LaserTally
+from .picam import PicameraSource
+from .record import Recorder
+from .runner import DryRunSink, Observer, RealPacer, Sink, StatusLine, run
+from .sim.camera import CameraModel, CameraPose, Renderer
+from .sim.flight import FlightResult, fly
+from .sim.room import SCENARIOS, make_scenario
+from .sources import CameraSource, Frame, FrameSource, ImageFolderSource, VideoFileSource
 
 EXIT_OK = 0
 EXIT_FAILED = 1
@@ -42,19 +46,25 @@ MAX_SIZE = (4096, 4096)  # the simulated camera's largest frame (about 50 MB of 
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="pilot", description="The Raspberry Pi vision pilot of the drone.")
+    p.add_argument("--version", action="version", version=f"pilot {__version__} (protocol {dp.PROTOCOL_NAME} "
+                   f"{dp.PROTOCOL_VERSION}, spec fingerprint {dp.SPEC_FINGERPRINT})")
     where = p.add_argument_group("where to fly")
     where.add_argument("--sim", action="store_true", help="fly the simulated room (the default without --port)")
     where.add_argument("--port", help="serial port or pyserial URL of the drone's Arduino (e.g. /dev/ttyACM0)")
     where.add_argument("--baud", type=int, default=dp.BAUD, help=f"baud rate (default {dp.BAUD}, from the spec)")
     where.add_argument("--arm", action="store_true", help="allow arming a real drone (required with --port)")
     src = p.add_argument_group("frames (real flights and --dry-run)")
-    src.add_argument("--camera", help="camera index or device (default 0 with --port)")
+    src.add_argument("--camera", help="camera index or device (V4L2, default 0 with --port), or picam for the "
+                     "Raspberry Pi camera through picamera2")
     src.add_argument("--video", help="a video file as the frame source")
     src.add_argument("--images", help="a folder of images as the frame source")
     p.add_argument("--detector", choices=config_mod.DETECTORS, help="target detector (default: config, else hsv)")
     p.add_argument("--config", help="YAML config file (see pilot/config.py for every option)")
     p.add_argument("--dry-run", action="store_true", help="decide and print the commands, send nothing")
     p.add_argument("--record", metavar="DIR", help="write the annotated video, the JSON-lines log and the path picture")
+    p.add_argument("--force", action="store_true", help="let --record overwrite an earlier recording in DIR")
+    p.add_argument("--serve", metavar="[HOST:]PORT", help="serve a live view with an emergency Stop (host "
+                   "127.0.0.1 unless given; the URL, with its token, is printed at start-up)")
     p.add_argument("--seed", type=int, default=1, help="simulated room seed (default 1)")
     p.add_argument("--scenario", choices=SCENARIOS, default="ahead", help="simulated scenario (default ahead)")
     p.add_argument("--max-seconds", type=float, default=60.0, help="flight time limit, seconds (default 60)")
@@ -125,8 +135,8 @@ class _StillSim:
         self.scenario = make_scenario(scenario_name, seed)
         self.renderer = Renderer(self.scenario, CameraModel(*size))
         x, y, heading = self.scenario.start
-        pan, tilt = dp.SERVOS[dp.ServoName.PAN].default, dp.SERVOS[dp.ServoName.TILT].default
-        self.pose = CameraPose.from_drone(x, y, 1.2, heading, pan, tilt)
+        pan, tilt = dp.SERVOS[dp.ServoName.PAN], dp.SERVOS[dp.ServoName.TILT]
+        self.pose = CameraPose.from_drone(x, y, 1.2, heading, pan.default, tilt.default)
         self._index = 0
 
     def read(self) -> Frame | None:
@@ -151,6 +161,8 @@ def _frame_source(args: argparse.Namespace) -> FrameSource | _StillSim:
         return ImageFolderSource(args.images)
     if args.camera is not None or args.port:
         cam = args.camera if args.camera is not None else "0"
+        if cam == "picam":
+            return PicameraSource()
         return CameraSource(int(cam) if cam.isdigit() else cam)
     return _StillSim(args.scenario, args.seed, _size(args.size))
 
@@ -160,7 +172,33 @@ def _fly_sim(args: argparse.Namespace, cfg: PilotConfig) -> int:
     status = None if args.no_status else StatusLine()
     if status is not None:
         observers.append(status)
-    result = fly(
+    live = LiveSession(args.serve, simulated=True) if args.serve else None
+    if live is not None:
+        observers.extend(live.observers())
+    try:
+        result = _fly_sim_with(args, cfg, observers)
+    finally:
+        if live is not None:
+            live.close("the flight is over")
+    stop_note(live)
+    if status is not None:
+        status.finish()
+    print(result.summary())
+    print(f"drone:     laser {'ON' if result.final_laser else 'off'}, {'armed' if result.final_armed else 'disarmed'}, "
+          f"altitude {result.final_altitude:.2f} m (the virtual drone's outputs at the end)")
+    if result.record_dir:
+        print(f"recording: {result.video}")
+        print(f"log:       {Path(result.record_dir) / 'log.jsonl'}")
+        print(f"path:      {result.path_picture}")
+    if result.error:
+        print(f"pilot: stopped by {result.error}", file=sys.stderr)
+    if result.error and ("KeyboardInterrupt" in result.error or "StopRequested" in result.error):
+        return EXIT_INTERRUPTED
+    return EXIT_OK if result.success and result.wall_hits == 0 else EXIT_FAILED
+
+
+def _fly_sim_with(args: argparse.Namespace, cfg: PilotConfig, observers: list[Observer]) -> FlightResult:
+    return fly(
         args.scenario,
         args.seed,
         config=cfg,
@@ -171,18 +209,6 @@ def _fly_sim(args: argparse.Namespace, cfg: PilotConfig) -> int:
         observers=observers,
         max_wind=args.wind,
     )
-    if status is not None:
-        status.finish()
-    print(result.summary())
-    if result.record_dir:
-        print(f"recording: {result.video}")
-        print(f"log:       {Path(result.record_dir) / 'log.jsonl'}")
-        print(f"path:      {result.path_picture}")
-    if result.error:
-        print(f"pilot: stopped by {result.error}", file=sys.stderr)
-    if result.error and "KeyboardInterrupt" in result.error:
-        return EXIT_INTERRUPTED
-    return EXIT_OK if result.success and result.wall_hits == 0 else EXIT_FAILED
 
 
 def _fly_real(args: argparse.Namespace, cfg: PilotConfig) -> int:
@@ -193,17 +219,22 @@ def _fly_real(args: argparse.Namespace, cfg: PilotConfig) -> int:
             file=sys.stderr,
         )
         return EXIT_USAGE
-    recorder = Recorder(args.record, fps=cfg.link.rate_hz) if args.record else None
-    observers: list[Observer] = []
+    # the recording and the live view start once the frame source and the link are open, so that a
+    # failure there leaves no half-written recording behind
+    recorder: Recorder | None = None
+    live: LiveSession | None = None
+    early: list[LogEntry] = []  # link traffic before the recorder exists (the ready line)
+    tally = LaserTally()
+    observers: list[Observer] = [tally]
     status = None if args.no_status else StatusLine()
     if status is not None:
         observers.append(status)
-    if recorder is not None:
-        observers.append(recorder)
 
     def link_log(entry: LogEntry) -> None:
         if recorder is not None:
             recorder.on_link(entry)
+        else:
+            early.append(entry)
 
     link: Link | None = None
     try:
@@ -218,8 +249,23 @@ def _fly_real(args: argparse.Namespace, cfg: PilotConfig) -> int:
                     ready_timeout_s=cfg.link.ready_timeout_s,
                     reconnect_s=cfg.link.reconnect_s,
                     log=link_log,
-                ).open()
+                )
+                try:
+                    link.open()
+                except PilotError as exc:
+                    hint = port_error_hint(exc, args.port)
+                    if hint is None:
+                        raise
+                    raise hint from exc
                 sink = link
+            if args.record:
+                recorder = Recorder(args.record, fps=cfg.link.rate_hz)
+                observers.append(recorder)
+                for entry in early:
+                    recorder.on_link(entry)
+            if args.serve:
+                live = LiveSession(args.serve, simulated=False)
+                observers.extend(live.observers())
             controller = Controller(cfg.controller)
             result = run(
                 source,
@@ -232,6 +278,8 @@ def _fly_real(args: argparse.Namespace, cfg: PilotConfig) -> int:
                 observers=observers,
             )
     finally:
+        if live is not None:
+            live.close("the flight is over")
         if link is not None:
             link.close()
         if recorder is not None:
@@ -239,7 +287,8 @@ def _fly_real(args: argparse.Namespace, cfg: PilotConfig) -> int:
             recorder.close()
         if status is not None:
             status.finish()
-    print(f"pilot: {result.reason}; final state {result.state.value}; laser fired: {result.fired}")
+    stop_note(live)
+    print(f"pilot: {result.reason}; final state {result.state.value}; {tally.summary()}")
     print(f"pilot: the drone confirmed: {result.confirmed}")
     if result.port_lost:
         print(f"pilot: {result.port_lost}", file=sys.stderr)
@@ -263,8 +312,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             if not args.config:
                 raise PilotError("option --calibrate needs --config FILE to save the ranges into")
             cfg = calibrate_to_config(args.calibrate, args.config, _roi(args.roi))
-            print(f"pilot: saved HSV ranges {cfg.hsv.ranges} to {args.config}")
+            print(f"pilot: saved HSV ranges {cfg.hsv.ranges} to {args.config}; preview {preview_path(args.config)}")
             return EXIT_OK
+        check_sources(args)
         _check_args(args)
         cfg = _load_config(args)
         if args.port and args.sim:

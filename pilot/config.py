@@ -16,7 +16,7 @@ from typing import Any, TypeVar
 import drone_protocol as dp
 import yaml
 
-from pilot.errors import ConfigError
+from .errors import ConfigError
 
 HsvTriple = tuple[int, int, int]
 HsvRange = tuple[HsvTriple, HsvTriple]
@@ -33,6 +33,19 @@ class HsvConfig:
     ranges: tuple[HsvRange, ...] = DEFAULT_RED
     min_area: int = 30
     open_kernel: int = 3
+    target_diameter_m: float = 0.30  # the ball's diameter: apparent size -> range
+    min_score: float = 0.2  # candidates scoring below this are not reported at all
+
+
+@dataclass(frozen=True)
+class VisionConfig:
+    """Frame checks and the tracker, shared by both detectors (see pilot/frames.py, pilot/tracking.py)."""
+
+    range_min_m: float = 0.3  # an apparent size implying a range outside this is not the target
+    range_max_m: float = 15.0  # a big room's diagonal
+    bridge_frames: int = 3  # missed frames the tracker predicts through
+    max_jump: float = 0.2  # fraction of the frame width a tracked target may move in one frame
+    frozen_frames: int = 5  # identical frames in a row that make the camera count as frozen
 
 
 @dataclass(frozen=True)
@@ -64,7 +77,13 @@ class ControllerConfig:
     # disarm sequence, plus room for lost frames); then the pilot stops sending and the failsafe takes over
     land_ms: int = dp.LANDING_MS + dp.ARMING_HOLD_MS + 2000
     arm_margin_ms: int = 300  # wait after the drone confirms it armed
-    horizontal_fov_deg: float = 60.0  # camera field of view, for pan/tilt corrections
+    horizontal_fov_deg: float = 60.0  # camera field of view, for pan/tilt corrections and range estimates
+    # the gate (pilot/gating.py); figures behind the defaults in bench/vision/RESULTS.md
+    acquire_confidence: float = 0.5  # a sighting counts only at or above this confidence
+    confirm_frames: int = 3  # measured, confident, centred, in-range frames in a row before the laser may fire
+    fire_tolerance: float = 0.10  # normalised error within which a frame counts as centred for the gate
+    fire_range_max_m: float = 3.0  # the laser fires only on a target estimated closer than this
+    blind_frames: int = 20  # bad frames in a row (black, saturated, frozen, malformed) before landing
 
 
 @dataclass(frozen=True)
@@ -81,6 +100,7 @@ class LinkConfig:
 class PilotConfig:
     detector: str = "hsv"
     hsv: HsvConfig = field(default_factory=HsvConfig)
+    vision: VisionConfig = field(default_factory=VisionConfig)
     aruco: ArucoConfig = field(default_factory=ArucoConfig)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     link: LinkConfig = field(default_factory=LinkConfig)
@@ -163,14 +183,11 @@ RANGES: dict[str, tuple[float, float]] = {
     "controller.approach_size": (0.001, 1.0),
     "controller.retreat_size": (0.0, 1.0),
     "controller.aim_tolerance": (0.001, 1.0),
-    "controller.horizontal_fov_deg": (1.0, 179.0),
     "link.rate_hz": (1.0, 50.0),
     "link.keepalive_fraction": (0.01, 0.99),
     "link.ready_timeout_s": (0.1, 60.0),
     "link.reconnect_s": (0.0, 60.0),
-    "hsv.min_area": (0, 10_000_000),
     "hsv.open_kernel": (1, 99),
-    "aruco.marker_size_m": (0.001, 100.0),
     "aruco.adaptive_thresh_constant": (-255.0, 255.0),
 }
 
@@ -203,6 +220,7 @@ def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
                 )
     if not config.hsv.ranges:
         raise ConfigError(f"{where}: option 'hsv.ranges' must hold at least one range")
+    _validate_vision(config, where)
     c = config.controller
     if c.retreat_size >= c.approach_size:
         raise ConfigError(
@@ -210,6 +228,30 @@ def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
             f"'controller.approach_size' ({c.approach_size}) for the hysteresis to work"
         )
     return config
+
+
+def _in(where: str, option: str, value: float, lo: float, hi: float) -> None:
+    if not lo <= value <= hi:
+        raise ConfigError(f"{where}: option {option!r} must be within {lo:g}..{hi:g}, got {value!r}")
+
+
+def _validate_vision(config: PilotConfig, where: str) -> None:
+    h, v, c = config.hsv, config.vision, config.controller
+    _in(where, "hsv.target_diameter_m", h.target_diameter_m, 0.01, 5.0)
+    _in(where, "hsv.min_score", h.min_score, 0.0, 1.0)
+    _in(where, "hsv.min_area", h.min_area, 4, 1_000_000)
+    _in(where, "aruco.marker_size_m", config.aruco.marker_size_m, 0.01, 5.0)
+    _in(where, "vision.range_min_m", v.range_min_m, 0.0, 100.0)
+    _in(where, "vision.range_max_m", v.range_max_m, v.range_min_m + 0.1, 1000.0)
+    _in(where, "vision.bridge_frames", v.bridge_frames, 0, 30)
+    _in(where, "vision.max_jump", v.max_jump, 0.01, 1.0)
+    _in(where, "vision.frozen_frames", v.frozen_frames, 2, 1000)
+    _in(where, "controller.horizontal_fov_deg", c.horizontal_fov_deg, 10.0, 170.0)
+    _in(where, "controller.acquire_confidence", c.acquire_confidence, 0.05, 1.0)
+    _in(where, "controller.confirm_frames", c.confirm_frames, 1, 100)
+    _in(where, "controller.fire_tolerance", c.fire_tolerance, c.aim_tolerance, 1.0)
+    _in(where, "controller.fire_range_max_m", c.fire_range_max_m, v.range_min_m, v.range_max_m)
+    _in(where, "controller.blind_frames", c.blind_frames, 1, 1000)
 
 
 def from_dict(data: dict[str, Any], where: str = "config") -> PilotConfig:

@@ -40,18 +40,39 @@ States (``State``)::
 from __future__ import annotations
 
 import math
+import time
+from collections.abc import Callable
 
 import drone_protocol as dp
 
-from pilot.controller_core import FLYING, LOCKED, ControllerCore, State, Transition, speed_for
-from pilot.detect import Detection
+from .config import ControllerConfig
+from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, speed_for
+from .detection import Detection
+from .gating import Gate
 
 __all__ = ["FLYING", "LOCKED", "Controller", "State", "Transition"]
 
 
 class Controller(ControllerCore):
+    def __init__(self, config: ControllerConfig | None = None, clock: Callable[[], float] = time.monotonic) -> None:
+        super().__init__(config, clock)
+        self.gate = Gate(self.cfg)  # vision gate (issue 12): every sighting and every laser-on goes through it
+
+    def _decide(self, det: Detection | None) -> bytes | None:
+        # -- vision gate (issue 12): a bad frame holds (laser off), too many in a row land ------------
+        self.gate.observe(det)
+        if self.gate.fault is not None and self.state in FLYING - {State.TAKEOFF, State.HOLD}:
+            if self.gate.fault_frames >= self.cfg.blind_frames:
+                off = self._laser(False)
+                self._go(State.LAND, f"camera: {self.gate.fault.value} frames")
+                return off if off is not None else self._on_land(det)
+            off = self._laser(False)
+            return off if off is not None else self._emit(dp.hold_altitude())
+        # -- end of the vision gate --------------------------------------------------------------------
+        return super()._decide(det)
+
     def _found(self, det: Detection | None) -> bool:
-        return det is not None and det.found
+        return det is not None and det.found and self.gate.acquired()  # vision gate: confident enough
 
     def _on_search(self, det: Detection | None) -> bytes | None:
         if self._found(det):
@@ -99,7 +120,7 @@ class Controller(ControllerCore):
     def _on_track(self, det: Detection | None) -> bytes | None:
         if self._lost(det, self.cfg.lost_frames):
             return self._to_search("target lost while tracking")
-        if det is None or not det.found:
+        if det is None or not self._found(det):
             if self._coast is not None and self._misses <= self.cfg.coast_frames:
                 return self._emit(self._coast)  # a missed frame or two (a far, flickering target): keep approaching
             return self._emit(dp.hold_altitude())
@@ -156,7 +177,7 @@ class Controller(ControllerCore):
     def _on_aim(self, det: Detection | None) -> bytes | None:
         if self._lost(det, self.cfg.lost_frames):
             return self._to_search("target lost while aiming")
-        if det is None or not det.found:
+        if det is None or not self._found(det):
             return self._emit(dp.hold_altitude())
         self._remember_side(det)
         if det.relative_size < self.cfg.retreat_size:
@@ -167,7 +188,7 @@ class Controller(ControllerCore):
             self._centred = 0
             return correction
         self._centred += 1
-        if self._centred >= self.cfg.aim_frames:
+        if self._centred >= self.cfg.aim_frames and self.gate.confirmed():  # vision gate: confirmed to fire
             self._go(State.FIRE, "locked and centred")
             self._fire_started_ms = self._now()
             self.lit_ms = 0
@@ -185,7 +206,7 @@ class Controller(ControllerCore):
             off = self._laser(False)
             self._go(State.LAND, f"laser on target for {lit_now} ms")
             return off if off is not None else self._on_land(det)
-        if det is None or not det.found:
+        if det is None or not self._found(det):
             self._misses += 1
             off = self._laser(False)  # never lit without a lock
             if self._misses >= self.cfg.lost_frames:
@@ -198,6 +219,9 @@ class Controller(ControllerCore):
             off = self._laser(False)
             self._go(State.AIM, "off centre while firing")
             return off if off is not None else self._on_aim(det)
+        if not self.gate.confirmed():  # vision gate: found, but not confirmed in enough frames in a row
+            off = self._laser(False)
+            return off if off is not None else self._emit(dp.hold_altitude())
         on = self._laser(True)
         if on is not None:
             return on

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import drone_protocol as dp
 
-from pilot.config import ControllerConfig
-from pilot.detect import Detection
-from pilot.drone_view import DroneView
+from .config import ControllerConfig
+from .detection import Detection
+from .drone_view import DroneView
 
 
 class State(enum.Enum):
@@ -203,6 +203,9 @@ class ControllerCore:
         fix = self._laser_fix()
         if fix is not None:
             return fix
+        return self._decide(det)
+
+    def _decide(self, det: Detection | None) -> bytes | None:
         handler = getattr(self, f"_on_{self.state.value}")
         result: bytes | None = handler(det)
         return result

@@ -26,8 +26,8 @@ from typing import Any, Self
 import drone_protocol as dp
 import serial
 
-from pilot.closing import Closing
-from pilot.errors import FingerprintMismatch, LinkError, PortLost, ReadyTimeout
+from .closing import Closing
+from .errors import FingerprintMismatch, LinkError, PortLost, ReadyTimeout
 
 MAX_LINE = 128
 

@@ -25,4 +25,4 @@ pilot-test: deps
 	$(PY) -m pytest -q tests/pilot
 
 bench-pilot: deps firmware-host
-	PILOT_VIRTUAL_DRONE=$(PILOT_VD) $(PY) bench/pilot/run.py $(BENCH_PILOT_FLAGS)
+	PILOT_VIRTUAL_DRONE=$(PILOT_VD) $(PY) -m bench.pilot.run $(BENCH_PILOT_FLAGS)

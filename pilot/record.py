@@ -18,14 +18,40 @@ import cv2
 import drone_protocol as dp
 import numpy as np
 
-from pilot.closing import Closing
-from pilot.link import LogEntry
-from pilot.runner import Tick
-from pilot.sim.room import Scenario
+from .closing import Closing
+from .errors import PilotError
+from .link import LogEntry
+from .overlay import annotate
+from .runner import Tick
+from .sim.room import Scenario
 
 VIDEO = "flight.avi"
 LOG = "log.jsonl"
 PATH_PICTURE = "path.png"
+
+
+RECORDING_FILES = (VIDEO, LOG, PATH_PICTURE)
+
+
+def prepare_directory(directory: str | Path, force: bool = False) -> Path:
+    """Check ``--record DIR`` before anything flies: a folder (made if missing) that holds no earlier
+    recording, unless ``force`` (then the earlier recording's files are removed first)."""
+    path = Path(directory)
+    if path.exists() and not path.is_dir():
+        raise PilotError(f"option --record: {str(path)!r} is a file, not a folder: name a folder")
+    existing = [name for name in RECORDING_FILES if (path / name).exists()]
+    if existing and not force:
+        raise PilotError(
+            f"option --record: {str(path)!r} already holds a recording ({', '.join(existing)}): "
+            "pass --force to overwrite it, or name another folder"
+        )
+    try:
+        for name in existing:
+            (path / name).unlink()
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise PilotError(f"option --record: cannot write into {str(path)!r}: {exc.strerror or exc}") from exc
+    return path
 
 
 def _reply_text(reply: dp.Reply) -> str:
@@ -40,6 +66,7 @@ class Recorder(Closing):
         self._writer: cv2.VideoWriter | None = None
         self._log = (self.dir / LOG).open("w", encoding="utf-8")
         self._last_command = ""
+        self._t0: float | None = None
         self._closed = False
 
     @property
@@ -57,9 +84,17 @@ class Recorder(Closing):
     def write(self, record: dict[str, Any]) -> None:
         if not self._closed:
             self._log.write(json.dumps(record, sort_keys=True) + "\n")
+            self._log.flush()  # a crash loses no line: the log is what is left to read afterwards
+
+    def _since_start(self, t: float) -> float:
+        """Seconds from the first event recorded (the link opening or the first tick), whatever the clock's
+        origin (a real run's monotonic clock counts from the machine's boot)."""
+        if self._t0 is None:
+            self._t0 = t
+        return t - self._t0
 
     def on_link(self, entry: LogEntry) -> None:
-        self.write({"t": round(entry.t, 3), "link": entry.kind, "data": entry.data})
+        self.write({"t": round(self._since_start(entry.t), 3), "link": entry.kind, "data": entry.data})
 
     def on_tick(self, tick: Tick) -> None:
         det = tick.detection
@@ -67,7 +102,7 @@ class Recorder(Closing):
             self._last_command = tick.command.decode("ascii", "replace")
         self.write(
             {
-                "t": round(tick.t, 3),
+                "t": round(self._since_start(tick.t), 3),
                 "tick": tick.index,
                 "state": tick.state.value,
                 "laser": tick.laser_on,
@@ -88,24 +123,10 @@ class Recorder(Closing):
             self._video(tick)
 
     def _video(self, tick: Tick) -> None:
-        assert tick.frame is not None
-        img = np.ascontiguousarray(tick.frame.image).copy()
-        h, w = img.shape[:2]
+        img = annotate(tick, self._since_start(tick.t), self._last_command)
         if self._writer is None:
+            h, w = img.shape[:2]
             self._writer = cv2.VideoWriter(str(self.video_path), cv2.VideoWriter.fourcc(*"MJPG"), self.fps, (w, h))
-        det = tick.detection
-        cv2.drawMarker(img, (w // 2, h // 2), (0, 255, 0), cv2.MARKER_CROSS, 12, 1)
-        if det is not None and det.found:
-            r = max(2, int(det.size / 2))
-            cv2.circle(img, (int(det.cx), int(det.cy)), r, (0, 255, 255), 1)
-            cv2.line(img, (w // 2, h // 2), (int(det.cx), int(det.cy)), (0, 255, 255), 1)
-        font = cv2.FONT_HERSHEY_SIMPLEX
-        scale = max(0.35, w / 900)
-        cv2.putText(img, f"{tick.t:6.2f}s {tick.state.value}", (4, int(14 * scale / 0.35)), font, scale, (0, 0, 0), 1)
-        cv2.putText(img, f"cmd {self._last_command}", (4, h - 6), font, scale, (0, 0, 0), 1)
-        if tick.laser_on:
-            cv2.putText(img, "LASER", (w - int(60 * scale / 0.35), int(14 * scale / 0.35)), font, scale, (0, 0, 255), 1)
-            cv2.circle(img, (w // 2, h // 2), 3, (0, 0, 255), -1)
         self._writer.write(img)
 
     def path_png(self, scenario: Scenario, path: list[tuple[float, float, float, float]], scale: int = 60) -> Path:

@@ -28,10 +28,15 @@ from typing import Protocol, TextIO
 
 import drone_protocol as dp
 
-from pilot.controller import Controller, State
-from pilot.detect import Detection, Detector
-from pilot.errors import FrameSourceError, PortLost
-from pilot.sources import Frame, FrameSource
+from .controller import Controller, State
+from .detect import Detection, Detector
+from .errors import FrameSourceError, PortLost
+from .sources import Frame, FrameSource
+
+
+class StopRequested(KeyboardInterrupt):
+    """A stop asked from another thread (the live view's Stop button), raised in the loop by an observer
+    (pilot.observers.StopSwitch): the same safe way out as Ctrl-C."""
 
 
 class Sink(Protocol):
@@ -134,6 +139,7 @@ class StatusLine:
         self._last = -math.inf
         self._state: tuple[State, str] | None = None
         self._sends: deque[float] = deque()
+        self._t0: float | None = None  # the first tick: times are printed from the start of the run
 
     def on_tick(self, tick: Tick) -> None:
         if tick.command is not None:
@@ -147,12 +153,12 @@ class StatusLine:
         if not self.live and not changed:
             return
         self._last = tick.t
+        if self._t0 is None:
+            self._t0 = tick.t
         seen = "yes" if tick.detection is not None and tick.detection.found else "no "
         last = tick.command.decode("ascii") if tick.command else "      "
-        line = (
-            f"t {tick.t:7.2f}s  state {tick.state.value:8s}  target {seen}  {len(self._sends):3d} cmd/s  last {last}"
-            f"  drone {tick.drone or '?'}"
-        )
+        line = (f"t {tick.t - self._t0:7.2f}s  state {tick.state.value:8s}  target {seen}  "
+                f"{len(self._sends):3d} cmd/s  last {last}  drone {tick.drone or '?'}")
         self.out.write(f"\r{line}" if self.live else f"{line}\n")
         self.out.flush()
 
@@ -212,6 +218,8 @@ def run(
         reason, error = f"camera lost: {exc}", exc
     except PortLost as exc:
         reason, error = f"serial port lost: {exc}", exc
+    except StopRequested as exc:
+        reason, error = f"stop requested ({exc})", exc
     except KeyboardInterrupt as exc:
         reason, error = "interrupted", exc
     except BaseException as exc:  # any stage: land safely first, report afterwards

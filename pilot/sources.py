@@ -17,8 +17,8 @@ from typing import Protocol, Self
 import cv2
 from cv2.typing import MatLike
 
-from pilot.closing import Closing
-from pilot.errors import FrameSourceError
+from .closing import Closing
+from .errors import FrameSourceError
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".ppm", ".pgm", ".tif", ".tiff")
 
@@ -57,7 +57,6 @@ class FrameSourceBase(Closing):
 
     def close(self) -> None:
         self._closed = True
-
 
 
 class CameraSource(FrameSourceBase):
@@ -136,6 +135,24 @@ class ImageFolderSource(FrameSourceBase):
         if not self._paths:
             raise FrameSourceError(f"image folder {str(self.folder)!r}: holds no images ({', '.join(IMAGE_SUFFIXES)})")
         self._next = 0
+        self._check_sizes()
+
+    def _check_sizes(self) -> None:
+        """One size for every image, checked before the first frame: a recording and the detector's
+        geometry need it, and a failure halfway through a run would leave half a recording."""
+        first: tuple[str, tuple[int, ...]] | None = None
+        for path in self._paths:
+            image = cv2.imread(str(path), cv2.IMREAD_COLOR)
+            if image is None:
+                raise FrameSourceError(f"option --images: cannot decode {str(path)!r}: remove it or fix it")
+            if first is None:
+                first = (path.name, image.shape[:2])
+            elif image.shape[:2] != first[1]:
+                h, w = image.shape[:2]
+                raise FrameSourceError(
+                    f"option --images: {path.name!r} is {w}x{h} but {first[0]!r} is {first[1][1]}x{first[1][0]}: "
+                    "every image of the folder must have one size"
+                )
 
     def read(self) -> Frame | None:
         if self._closed or self._next >= len(self._paths):

@@ -20,3 +20,10 @@ FW_BENCH_ELVES := $(foreach b,$(FW_BENCH_BOARDS),$(FW_BUILD)/$(b)/$(b).elf)
 
 bench-firmware: $(VENV_STAMP) $(FW_BENCH_ELVES) $(FW_BUILD)/sim/drone_sim
 	$(PY) bench/firmware/bench_firmware.py --build $(FW_BUILD)
+
+# The generated parser alone: AVR cycles per byte, flash per command, spurious frames under corruption
+# (bench/firmware/parser/parser_bench.py); writes bench/firmware/PARSER_RESULTS.md.
+.PHONY: bench-parser
+bench-parser: $(VENV_STAMP) $(FW_BUILD)/sim/drone_sim
+	$(PY) bench/firmware/parser/parser_bench.py
+bench-firmware: bench-parser

@@ -54,7 +54,7 @@ def frame_of(width: int, height: int) -> np.ndarray:
     heading = float(np.arctan2(ty - y, tx - x))
     d = float(np.hypot(tx - x, ty - y))
     k = (d - 2.0) / d  # two metres from the target
-    pan0, tilt0 = dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default
+    pan0, tilt0 = dp.SERVOS[dp.ServoName.PAN].default, dp.SERVOS[dp.ServoName.TILT].default
     pose = CameraPose.from_drone(x + (tx - x) * k, y + (ty - y) * k, tz - 0.2, heading, pan0, tilt0)
     return r.render(pose, 0.0)
 

@@ -191,9 +191,26 @@ def _feed_each(frames: Sequence[bytes]) -> Callable[[], None]:
 
 
 def _clear_decode_cache() -> None:
-    cache = getattr(dp, "_DECODED", None)  # the generated decoder's memo of frames, if it has one
-    if isinstance(cache, dict):
-        cache.clear()
+    dp.codec.DECODED.clear()  # the generated decoder's memo of frames
+
+
+def _feed_stream(chunks: Sequence[bytes]) -> Callable[[], None]:
+    def loop() -> None:
+        feed = dp.StreamDecoder(time_fn=lambda: 0.0).feed
+        for chunk in chunks:
+            feed(chunk, 0.0)
+
+    return loop
+
+
+def _chunks(data: bytes, size: int) -> list[bytes]:
+    return [data[i:i + size] for i in range(0, len(data), size)]
+
+
+def _with_garbage(frames: Sequence[bytes], seed: int = 5) -> bytes:
+    """The frames with as many random bytes as frame bytes between them (50 % garbage)."""
+    rng = random.Random(seed)
+    return b"".join(bytes(rng.randrange(256) for _ in range(len(f))) + f for f in frames)
 
 
 def _python_row(measure: str, result: Paired, baseline_name: str, target: float | None) -> Row:
@@ -223,8 +240,10 @@ def bench_python(settings: Settings) -> list[Row]:
     # What the Arduino answers to that mix: mostly acceptances, some refusals and the odd failsafe.
     reply_rng = random.Random(4)
     errors = list(dp.ErrorKind)
-    replies = [dp.accepted_line(dp.decode(f)) if reply_rng.random() < 0.9 else
-               (dp.rejected_line(reply_rng.choice(errors)) if reply_rng.random() < 0.95 else dp.failsafe_line())
+    moving, failsafe = dp.DroneState.MOVING, dp.DroneState.FAILSAFE
+    replies = [dp.accepted_line(dp.decode(f), moving, False) if reply_rng.random() < 0.9 else
+               (dp.rejected_line(reply_rng.choice(errors), moving, False) if reply_rng.random() < 0.95
+                else dp.failsafe_line(failsafe, False))
                for f in frames]
 
     # The subjects must produce what the floors produce before they are timed.
@@ -246,9 +265,18 @@ def bench_python(settings: Settings) -> list[Row]:
                                                   n, passes), "slice+int", PYTHON_TARGET),
         _python_row("decode(frame), 1000 distinct frames, cold", paired(
             _decode_each(dp.decode, distinct), _decode_each(floor_decode, distinct), n, passes,
-            before_subject=_clear_decode_cache), "slice+int", None),
+            before_subject=_clear_decode_cache), "slice+int", 2.0),
         _python_row("StreamDecoder.feed(6-byte chunks), mix", paired(
             _feed_each(frames), _decode_each(floor_decode, frames), n, max(passes // 5, 10)), "slice+int", None),
+        _python_row("StreamDecoder, clean stream in 4 kB reads, cold", paired(
+            _feed_stream(_chunks(b"".join(distinct), 4096)), _decode_each(floor_decode, distinct), n,
+            max(passes // 5, 10), before_subject=_clear_decode_cache), "slice+int", 3.0),
+        _python_row("StreamDecoder, 50 % garbage in 4 kB reads, cold", paired(
+            _feed_stream(_chunks(_with_garbage(distinct), 4096)), _decode_each(floor_decode, distinct), n,
+            max(passes // 5, 10), before_subject=_clear_decode_cache), "slice+int", 10.0),
+        _python_row("StreamDecoder, clean stream one byte per call", paired(
+            _feed_stream(_chunks(b"".join(frames), 1)), _decode_each(floor_decode, frames), n,
+            max(passes // 10, 10)), "slice+int", 10.0),
         _python_row("parse_reply(line), replies to the mix", paired(
             _decode_each(dp.parse_reply, replies), _decode_each(floor_reply, replies), n, max(passes // 5, 10)),
             "slice", None),

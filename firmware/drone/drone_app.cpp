@@ -5,6 +5,7 @@
 #include <avr/sleep.h>
 #endif
 
+#include "pin_io.h"
 #include "pins.h"
 #include "pulse_out.h"
 
@@ -65,7 +66,8 @@ static_assert(servo_us_exact_from(0), "servo_us_fast must round like the exact f
 
 uint16_t servo_us(uint8_t deg) { return servo_us_fast(deg); }
 
-void widths_of(const drone::Outputs& o, uint16_t w[pulse::OUTPUTS]) {
+// Not inlined: setup() and apply_outputs() share one copy.
+__attribute__((noinline)) void widths_of(const drone::Outputs& o, uint16_t w[pulse::OUTPUTS]) {
   w[pulse::ROLL] = o.roll;
   w[pulse::PITCH] = o.pitch;
   w[pulse::THROTTLE] = o.throttle;
@@ -86,7 +88,7 @@ void apply_outputs() {
   if (!(o == applied)) {
     applied = o;
     if (o.laser != laser_written) {
-      digitalWrite(pins::LASER, o.laser ? HIGH : LOW);
+      pin_io::flip_to(pins::LASER, o.laser);
       laser_written = o.laser;
     }
     widths_of(o, pending_widths);  // the newest widths always win
@@ -133,13 +135,12 @@ void bench_mark() { *mark_reg = mark_mask; }
 #endif
 
 void setup() {
-  pinMode(pins::LASER, OUTPUT);
-  digitalWrite(pins::LASER, LOW);
+  pin_io::output_low(pins::LASER);
   laser_written = false;
   widths_pending = false;
   updated_ms = millis();
 #ifdef DRONE_MARK_PIN
-  pinMode(DRONE_MARK_PIN, OUTPUT);
+  pin_io::output_low(DRONE_MARK_PIN);
   mark_reg = portInputRegister(digitalPinToPort(DRONE_MARK_PIN));
   mark_mask = digitalPinToBitMask(DRONE_MARK_PIN);
   // Calibration: empty marked spans, so the bench can subtract the cost of

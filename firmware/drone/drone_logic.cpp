@@ -1,5 +1,7 @@
 #include "drone_logic.h"
 
+#include "drone_limits.h"
+
 // Bench builds (-DDRONE_BENCH_PARSER_PIN=n) time the parser alone: the app
 // supplies this hook, which toggles a spare pin around StreamParser::feed().
 #ifdef DRONE_BENCH_PARSER_PIN
@@ -17,6 +19,11 @@ void drone_bench_parser_mark();
 #endif
 
 namespace drone {
+
+using limits::clamp16;
+using limits::servo_default;
+using limits::servo_max;
+using limits::servo_min;
 
 namespace {
 
@@ -48,61 +55,17 @@ const TestStep kSelfTest[] DRONE_FLASH = {
 constexpr uint8_t SELF_TEST_STEPS = sizeof(kSelfTest) / sizeof(kSelfTest[0]);
 static_assert(sizeof(kSelfTest) / sizeof(kSelfTest[0]) < 256, "steps are counted in a uint8_t");
 
-uint16_t clamp16(int32_t v, uint16_t lo, uint16_t hi) {
-  return v < lo ? lo : (v > hi ? hi : static_cast<uint16_t>(v));
-}
-
-dp::ChannelLimits limits(dp::Target t) { return dp::channel_limits(t); }
-
-// The failsafe throttle is the one output allowed outside Table 4: it must lie
-// below the recorded minimum for the flight controller to see a radio failsafe.
-static_assert(dp::FAILSAFE_THROTTLE_US < dp::THROTTLE_MIN, "failsafe throttle must be below the throttle range");
-
-uint8_t servo_default(dp::Target t) { return t == dp::Target::Pan ? dp::SERVO_PAN_DEFAULT : dp::SERVO_TILT_DEFAULT; }
-uint8_t servo_min(dp::Target t) { return t == dp::Target::Pan ? dp::SERVO_PAN_MIN : dp::SERVO_TILT_MIN; }
-uint8_t servo_max(dp::Target t) { return t == dp::Target::Pan ? dp::SERVO_PAN_MAX : dp::SERVO_TILT_MAX; }
-
 }  // namespace
-
-const char* state_name(State s) {
-  switch (s) {
-    case State::Disarmed: return "disarmed";
-    case State::Arming: return "arming";
-    case State::Armed: return "armed";
-    case State::HoldAltitude: return "hold_altitude";
-    case State::Moving: return "moving";
-    case State::Disarming: return "disarming";
-    case State::SelfTest: return "self_test";
-    case State::Failsafe: return "failsafe";
-  }
-  return "?";
-}
 
 bool operator==(const Outputs& a, const Outputs& b) {
   return a.roll == b.roll && a.pitch == b.pitch && a.throttle == b.throttle && a.yaw == b.yaw &&
          a.mode == b.mode && a.pan == b.pan && a.tilt == b.tilt && a.laser == b.laser;
 }
 
-Drone::Drone(Transmit tx)
-    : tx_(tx),
-      parser_(),
-      out_(),
-      state_(State::Disarmed),
-      armed_(false),
-      now_ms_(0),
-      state_since_ms_(0),
-      last_frame_ms_(0),
-      result_(dp::Error::None),
-      last_parser_error_(dp::Error::None),
-      test_step_(0),
-      laser_before_test_(false),
-      replies_dropped_(0) {}
-
 void Drone::begin(uint32_t now_ms) {
   now_ms_ = now_ms;
   last_frame_ms_ = now_ms;
   parser_.reset();
-  armed_ = false;
   out_.mode = dp::MODE_STABILIZE_US;
   out_.pan = dp::SERVO_PAN_DEFAULT;
   out_.tilt = dp::SERVO_TILT_DEFAULT;
@@ -131,7 +94,7 @@ bool Drone::receive(uint8_t byte, uint32_t now_ms) {
     // is answered once per kind of error (the parser counts every byte), so
     // noise cannot fill the transmit buffer ahead of real replies.
     const dp::Error e = parser_.last_error();
-    reply(line, dp::write_rejected(e, line));
+    reply(line, dp::write_rejected(e, state_, out_.laser, line));
     last_parser_error_ = e;
   }
   return complete;
@@ -140,23 +103,35 @@ bool Drone::receive(uint8_t byte, uint32_t now_ms) {
 void Drone::execute(const dp::Command& c, uint32_t now_ms) {
   // Any well-formed frame proves the link is alive, even one refused below.
   last_frame_ms_ = now_ms;
-  if (state_ == State::Failsafe) enter(armed_ ? State::Armed : State::Disarmed);
+  // The failsafe disarmed the drone: a new arming sequence is needed.
+  if (state_ == State::Failsafe) enter(State::Disarmed);
   result_ = dp::Error::None;
-  dp::dispatch(c, *this);
+  // A command this firmware has no handler for yet is answered `unsupported`.
+  const dp::Error unhandled = dp::dispatch(c, *this);
+  if (unhandled != dp::Error::None) result_ = unhandled;
+  // Every reply reports the state and laser the command left.
   char line[dp::REPLY_MAX_LENGTH];
   if (result_ == dp::Error::None) {
-    reply(line, dp::write_accepted(c, line));
+    reply(line, dp::write_accepted(c, state_, out_.laser, line));
   } else {
-    reply(line, dp::write_rejected(result_, line));
+    reply(line, dp::write_rejected(result_, state_, out_.laser, line));
   }
 }
 
 bool Drone::sequence_running() const {
-  return state_ == State::Arming || state_ == State::Disarming || state_ == State::SelfTest;
+  return state_ == State::Arming || state_ == State::Disarming || state_ == State::SelfTest ||
+         state_ == State::Landing;
 }
 
+// Off the ground: a disarm there would drop the drone.
+bool Drone::airborne() const {
+  return state_ == State::HoldAltitude || state_ == State::Moving || state_ == State::Landing;
+}
+
+void Drone::set_laser(bool on) { out_.laser = on; }
+
 void Drone::set_channel(dp::Target t, uint16_t us) {
-  const dp::ChannelLimits l = limits(t);
+  const dp::ChannelLimits l = limits::channel(t);
   const uint16_t v = clamp16(us, l.min, l.max);  // Table 4 extremes, whatever asked
   switch (t) {
     case dp::Target::Roll: out_.roll = v; break;
@@ -168,15 +143,16 @@ void Drone::set_channel(dp::Target t, uint16_t us) {
 }
 
 void Drone::sticks_neutral() {
-  set_channel(dp::Target::Roll, limits(dp::Target::Roll).median);
-  set_channel(dp::Target::Pitch, limits(dp::Target::Pitch).median);
-  set_channel(dp::Target::Yaw, limits(dp::Target::Yaw).median);
-  set_channel(dp::Target::Throttle, limits(dp::Target::Throttle).median);
+  // Table 4's medians (inside the extremes by construction: no clamp needed).
+  out_.roll = dp::ROLL_MEDIAN;
+  out_.pitch = dp::PITCH_MEDIAN;
+  out_.yaw = dp::YAW_MEDIAN;
+  out_.throttle = dp::THROTTLE_MEDIAN;
 }
 
 void Drone::sticks_on_ground() {
   sticks_neutral();
-  set_channel(dp::Target::Throttle, limits(dp::Target::Throttle).min);
+  out_.throttle = dp::THROTTLE_MIN;
 }
 
 void Drone::enter(State s) {
@@ -187,18 +163,27 @@ void Drone::enter(State s) {
     case State::Armed:
       sticks_on_ground();
       break;
-    case State::Arming:
     case State::Disarming:
+      set_laser(false);  // laser off is part of every disarm
+      // fall through
+    case State::Arming:
       // ArduCopter only takes stick (dis)arming in a manual-throttle mode.
       out_.mode = dp::MODE_STABILIZE_US;
       sticks_on_ground();
-      set_channel(dp::Target::Yaw, s == State::Arming ? limits(dp::Target::Yaw).max : limits(dp::Target::Yaw).min);
+      out_.yaw = s == State::Arming ? dp::YAW_MAX : dp::YAW_MIN;
       break;
     case State::HoldAltitude:
       sticks_neutral();
       break;
     case State::Moving:
       break;  // the caller set the sticks
+    case State::Landing:
+      // Descend in alt-hold: the throttle below its median asks the flight
+      // controller for a slow climb-rate down.
+      out_.mode = dp::MODE_ALT_HOLD_US;
+      sticks_neutral();
+      out_.throttle = dp::THROTTLE_LOW;
+      break;
     case State::SelfTest:
       sticks_on_ground();
       laser_before_test_ = out_.laser;
@@ -216,9 +201,18 @@ void Drone::enter_failsafe() {
   // Deliberately below Table 4's minimum: the flight controller reads it as
   // a radio failsafe (below its FS_THR_VALUE) and lands on its own.
   out_.throttle = dp::FAILSAFE_THROTTLE_US;
-  out_.laser = false;
+  set_laser(false);
+  // The flight controller lands and disarms on its own; this firmware counts
+  // the drone disarmed from here on (a new arming sequence is needed).
   char line[dp::REPLY_MAX_LENGTH];
-  reply(line, dp::write_failsafe(line));
+  reply(line, dp::write_failsafe(state_, out_.laser, line));
+}
+
+// The servos back to their defaults, the laser as it was before the test.
+void Drone::end_self_test() {
+  out_.pan = dp::SERVO_PAN_DEFAULT;
+  out_.tilt = dp::SERVO_TILT_DEFAULT;
+  set_laser(laser_before_test_);
 }
 
 void Drone::self_test_step(uint8_t step) {
@@ -236,7 +230,7 @@ void Drone::self_test_step(uint8_t step) {
       break;
     }
     default: {
-      const dp::ChannelLimits l = limits(s.target);
+      const dp::ChannelLimits l = limits::channel(s.target);
       set_channel(s.target, s.level < 0 ? l.low : s.level > 0 ? l.high : l.median);
       break;
     }
@@ -248,11 +242,8 @@ void Drone::update(uint32_t now_ms) {
   const uint32_t in_state = now_ms - state_since_ms_;
   if (state_ != State::Failsafe && now_ms - last_frame_ms_ >= dp::FAILSAFE_TIMEOUT_MS) {
     // Link lost: this overrides any movement or sequence in progress.
-    if (state_ == State::Arming) armed_ = false;
-    if (state_ == State::SelfTest) {
-      out_.pan = dp::SERVO_PAN_DEFAULT;
-      out_.tilt = dp::SERVO_TILT_DEFAULT;
-    }
+    if (state_ == State::SelfTest) end_self_test();
+    parser_.expire();  // a partial frame from before the silence never completes after it
     enter(State::Failsafe);
     return;
   }
@@ -261,127 +252,28 @@ void Drone::update(uint32_t now_ms) {
       if (in_state >= dp::COMMAND_TIMEOUT_MS) enter(State::HoldAltitude);
       break;
     case State::Arming:
-      if (in_state >= dp::ARMING_HOLD_MS) {
-        armed_ = true;
-        enter(State::Armed);
-      }
+      if (in_state >= dp::ARMING_HOLD_MS) enter(State::Armed);
       break;
     case State::Disarming:
-      if (in_state >= dp::ARMING_HOLD_MS) {
-        armed_ = false;
-        enter(State::Disarmed);
-      }
+      if (in_state >= dp::ARMING_HOLD_MS) enter(State::Disarmed);
+      break;
+    case State::Landing:
+      if (in_state >= dp::LANDING_MS) enter(State::Disarming);
       break;
     case State::SelfTest: {
-      const uint32_t step = in_state / SELF_TEST_STEP_MS;
-      if (step >= SELF_TEST_STEPS) {
-        out_.laser = laser_before_test_;
-        enter(State::Disarmed);
-      } else if (step != test_step_) {
-        test_step_ = static_cast<uint8_t>(step);
-        self_test_step(test_step_);
+      // The next step is due (no division: a 32-bit one costs flash and time).
+      if (in_state >= static_cast<uint32_t>(test_step_ + 1u) * SELF_TEST_STEP_MS) {
+        if (++test_step_ >= SELF_TEST_STEPS) {
+          end_self_test();
+          enter(State::Disarmed);
+        } else {
+          self_test_step(test_step_);
+        }
       }
       break;
     }
     default:
       break;
-  }
-}
-
-// --- command handlers -------------------------------------------------------
-
-void Drone::stick(const dp::Command& c) {
-  if (sequence_running()) {
-    result_ = dp::Error::Busy;
-    return;
-  }
-  if (!armed_) {
-    result_ = dp::Error::NotArmed;
-    return;
-  }
-  // The commanded plane gets the frame's speed; every other stick neutral.
-  sticks_neutral();
-  set_channel(dp::command_info(c.id).target, c.value);
-  enter(State::Moving);
-}
-
-void Drone::on_move(const dp::Command& c) { stick(c); }
-void Drone::on_turn(const dp::Command& c) { stick(c); }
-
-void Drone::on_servo(const dp::Command& c) {
-  if (state_ == State::SelfTest) {
-    result_ = dp::Error::Busy;
-    return;
-  }
-  const dp::CommandInfo info = dp::command_info(c.id);
-  const int16_t delta = static_cast<int16_t>(info.sense * static_cast<int16_t>(c.value));
-  switch (info.target) {
-    case dp::Target::Pan:
-    case dp::Target::Tilt: {
-      // Clamped to the servo's range: "sr0180" from 90 deg stops at the end.
-      uint8_t& angle = info.target == dp::Target::Pan ? out_.pan : out_.tilt;
-      angle = static_cast<uint8_t>(clamp16(angle + delta, servo_min(info.target), servo_max(info.target)));
-      break;
-    }
-    case dp::Target::Both:
-      out_.pan = dp::SERVO_PAN_DEFAULT;
-      out_.tilt = dp::SERVO_TILT_DEFAULT;
-      break;
-    default:
-      result_ = dp::Error::BadDirection;
-      break;
-  }
-}
-
-void Drone::on_laser(const dp::Command&) {
-  if (state_ == State::SelfTest) {
-    result_ = dp::Error::Busy;
-    return;
-  }
-  out_.laser = !out_.laser;
-}
-
-// An init direction the firmware has no routine for.
-void Drone::on_init(const dp::Command&) { result_ = dp::Error::BadDirection; }
-
-void Drone::on_arm(const dp::Command&) {
-  if (state_ == State::Disarming || state_ == State::SelfTest) {
-    result_ = dp::Error::Busy;
-  } else if (!armed_ && state_ != State::Arming) {
-    enter(State::Arming);
-  }
-  // Already armed or arming: accepted, nothing to do. Re-running the arm
-  // sequence in flight would cut the throttle.
-}
-
-void Drone::on_disarm(const dp::Command&) {
-  // Always honoured, even mid-sequence: the way to stop anything.
-  if (state_ == State::SelfTest) {
-    out_.laser = laser_before_test_;
-    out_.pan = dp::SERVO_PAN_DEFAULT;
-    out_.tilt = dp::SERVO_TILT_DEFAULT;
-  }
-  if (state_ == State::Arming) armed_ = false;
-  if (state_ != State::Disarming) enter(State::Disarming);
-}
-
-void Drone::on_hold_altitude(const dp::Command&) {
-  if (sequence_running()) {
-    result_ = dp::Error::Busy;
-  } else if (!armed_) {
-    result_ = dp::Error::NotArmed;
-  } else {
-    out_.mode = dp::MODE_ALT_HOLD_US;
-    enter(State::HoldAltitude);
-  }
-}
-
-void Drone::on_first_test(const dp::Command&) {
-  // Nudging sticks is only safe on the ground with the motors disarmed.
-  if (sequence_running() || armed_) {
-    result_ = dp::Error::Busy;
-  } else {
-    enter(State::SelfTest);
   }
 }
 

@@ -8,23 +8,29 @@
 
 #include <DroneProtocol.h>
 
+// Kept out of line on purpose: link-time inlining of these into loop() made
+// the Uno build about 200 bytes bigger.
+#define DRONE_NOINLINE __attribute__((noinline))
+
 namespace drone {
 
 namespace dp = drone_protocol;
 
-// What the outputs are doing. One state machine: sequences (arming,
-// disarming, self-test) are states, so nothing ever waits in delay().
-enum class State : uint8_t {
-  Disarmed,      // throttle minimum, other sticks neutral
-  Arming,        // throttle minimum + yaw full right for ARMING_HOLD_MS
-  Armed,         // armed, throttle minimum (on the ground)
-  HoldAltitude,  // sticks neutral, throttle median, mode alt-hold
-  Moving,        // one stick deflected until COMMAND_TIMEOUT_MS passes
-  Disarming,     // throttle minimum + yaw full left for ARMING_HOLD_MS
-  SelfTest,      // servo sweep, laser blinks, stick nudges; throttle minimum
-  Failsafe,      // no valid frame for FAILSAFE_TIMEOUT_MS
-};
-const char* state_name(State s);
+// What the outputs are doing: the spec's status states (dp::State, generated
+// from spec/drone.yaml, so every reply reports exactly this). One state
+// machine: sequences (arming, landing, disarming, self-test) are states, so
+// nothing ever waits in delay().
+//   disarmed       throttle minimum, other sticks neutral
+//   arming         throttle minimum + yaw full right for ARMING_HOLD_MS
+//   armed          armed, throttle minimum (on the ground)
+//   hold_altitude  sticks neutral, throttle median, mode alt-hold
+//   moving         one stick deflected until COMMAND_TIMEOUT_MS passes
+//   landing        alt-hold, throttle at its low speed for LANDING_MS
+//   disarming      throttle minimum + yaw full left for ARMING_HOLD_MS
+//   self_test      servo sweep, laser blinks, stick nudges; throttle minimum
+//   failsafe       no valid frame for FAILSAFE_TIMEOUT_MS; disarmed
+typedef dp::State State;
+inline const char* state_name(State s) { return dp::state_name(s); }
 
 struct Outputs {
   uint16_t roll, pitch, throttle, yaw, mode;  // RC pulse widths, us
@@ -40,49 +46,70 @@ class Drone {
   // buffer right now. The reply is then dropped (and counted), never waited on.
   typedef bool (*Transmit)(const char* data, uint8_t length);
 
-  explicit Drone(Transmit tx);
+  // constexpr: the global drone is initialised statically, with no
+  // constructor code at start-up.
+  explicit constexpr Drone(Transmit tx)
+      : tx_(tx),
+        parser_(),
+        out_(),
+        state_(State::Disarmed),
+        now_ms_(0),
+        state_since_ms_(0),
+        last_frame_ms_(0),
+        result_(dp::Error::None),
+        last_parser_error_(dp::Error::None),
+        test_step_(0),
+        laser_before_test_(false),
+        replies_dropped_(0) {}
 
   void begin(uint32_t now_ms);                 // boot: safe outputs, ready line
   // One serial byte; returns true when it completed a frame (which may have
   // changed the outputs).
-  bool receive(uint8_t byte, uint32_t now_ms);
-  void update(uint32_t now_ms);                // timers and sequences
+  DRONE_NOINLINE bool receive(uint8_t byte, uint32_t now_ms);
+  DRONE_NOINLINE void update(uint32_t now_ms);                // timers and sequences
 
   const Outputs& outputs() const { return out_; }
   State state() const { return state_; }
-  bool armed() const { return armed_; }
+  // The motors may spin (the spec's `armed` flag of the state).
+  bool armed() const { return dp::state_armed(state_); }
   uint16_t replies_dropped() const { return replies_dropped_; }
   const dp::StreamParser& parser() const { return parser_; }
 
-  // Handlers called by dp::dispatch(). Categories are handled generically
-  // from command_info(), so a direction added to the spec needs no edit here.
+  // Handlers called by dp::dispatch() (drone_handlers.cpp). Move, turn and
+  // servo are handled per category from the command's target, so a direction
+  // added to the spec needs no edit here; a command with no handler at all is
+  // answered `unsupported` by the generated dispatch.
   void on_move(const dp::Command& c);
   void on_turn(const dp::Command& c);
   void on_servo(const dp::Command& c);
-  void on_laser(const dp::Command& c);
-  void on_init(const dp::Command& c);
+  void on_laser_toggle(const dp::Command& c);
+  void on_laser_on(const dp::Command& c);
+  void on_laser_off(const dp::Command& c);
   void on_arm(const dp::Command& c);
   void on_disarm(const dp::Command& c);
   void on_hold_altitude(const dp::Command& c);
   void on_first_test(const dp::Command& c);
+  void on_land(const dp::Command& c);
 
  private:
-  void execute(const dp::Command& c, uint32_t now_ms);
+  DRONE_NOINLINE void execute(const dp::Command& c, uint32_t now_ms);
   void stick(const dp::Command& c);
+  void set_laser(bool on);
   void set_channel(dp::Target t, uint16_t us);
   void sticks_neutral();
   void sticks_on_ground();
-  void enter(State s);
+  DRONE_NOINLINE void enter(State s);
   void enter_failsafe();
+  void end_self_test();
   void self_test_step(uint8_t step);
   bool sequence_running() const;
+  bool airborne() const;
   void reply(const char* line, uint8_t length);
 
   Transmit tx_;
   dp::StreamParser parser_;
   Outputs out_;
   State state_;
-  bool armed_;
   uint32_t now_ms_;
   uint32_t state_since_ms_;
   uint32_t last_frame_ms_;

@@ -1,27 +1,39 @@
-// Default wiring of the drone firmware: the one place that names Arduino pins.
+// The drone firmware's pins, from the spec's wiring (DroneProtocolWiring.h).
 // Pulse-train timing lives here too: it is a property of the RC receiver
 // interface, not of the serial protocol (which comes from DroneProtocol.h).
 #ifndef DRONE_PINS_H
 #define DRONE_PINS_H
 
+#include <DroneProtocolWiring.h>
 #include <stdint.h>
+
+#include "pulse_schedule.h"
 
 namespace pins {
 
+// The pin numbers are the spec's (`wiring:` in spec/drone.yaml, generated into DroneProtocolWiring.h).
+namespace w = drone_protocol::wiring;
 // Parallel-PWM RC outputs, in ArduCopter's input order (ch1..ch5).
-constexpr uint8_t ROLL = 2;
-constexpr uint8_t PITCH = 3;
-constexpr uint8_t THROTTLE = 4;
-constexpr uint8_t YAW = 5;
-constexpr uint8_t MODE = 6;
+constexpr uint8_t ROLL = w::ROLL_PIN;
+constexpr uint8_t PITCH = w::PITCH_PIN;
+constexpr uint8_t THROTTLE = w::THROTTLE_PIN;
+constexpr uint8_t YAW = w::YAW_PIN;
+constexpr uint8_t MODE = w::MODE_PIN;
 // Camera/laser pan-tilt servos.
-constexpr uint8_t PAN = 9;
-constexpr uint8_t TILT = 10;
-// Laser (the Uno's on-board LED shares this pin, which helps on the bench).
-constexpr uint8_t LASER = 13;
-// PPM-sum build (-DDRONE_PPM): the five RC channels leave on this one pin,
-// which replaces the ROLL output; the other RC pins stay low.
-constexpr uint8_t PPM = ROLL;
+constexpr uint8_t PAN = w::PAN_PIN;
+constexpr uint8_t TILT = w::TILT_PIN;
+// Laser (on the Uno, pin 13 is also the on-board LED, which helps on the bench).
+constexpr uint8_t LASER = w::LASER_PIN;
+// PPM-sum build (DRONE_PPM, see drone_config.h): the five RC channels leave on this one pin, which may
+// replace an RC output; the other RC pins stay low.
+constexpr uint8_t PPM = w::PPM_PIN;
+
+// The PPM train carries the RC channels in pulse::Line order, so the spec's input order must be that one.
+static_assert(w::RC_INPUT_COUNT == pulse::RC_CHANNELS, "the spec wires another number of RC outputs");
+static_assert(w::ROLL_INPUT == pulse::ROLL + 1 && w::PITCH_INPUT == pulse::PITCH + 1 &&
+                  w::THROTTLE_INPUT == pulse::THROTTLE + 1 && w::YAW_INPUT == pulse::YAW + 1 &&
+                  w::MODE_INPUT == pulse::MODE + 1,
+              "wiring.rc_inputs must list roll, pitch, throttle, yaw, mode: the firmware's channel order");
 
 }  // namespace pins
 

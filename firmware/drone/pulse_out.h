@@ -6,6 +6,7 @@
 
 #include <stdint.h>
 
+#include "drone_config.h"  // DRONE_PPM: PPM-sum or parallel PWM
 #include "pulse_schedule.h"
 
 namespace pulse_out {

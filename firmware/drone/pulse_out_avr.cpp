@@ -8,6 +8,7 @@
 #include <avr/pgmspace.h>
 
 #include "pins.h"
+#include "pin_io.h"
 #include "pulse_out.h"
 
 namespace {
@@ -81,8 +82,7 @@ namespace pulse_out {
 void begin(const uint16_t width_us[pulse::OUTPUTS]) {
   for (uint8_t i = 0; i < pulse::LINE_COUNT; ++i) {
     const uint8_t pin = pgm_read_byte(&kPins[i]);
-    pinMode(pin, OUTPUT);
-    digitalWrite(pin, LOW);
+    pin_io::output_low(pin);
     toggle_reg[i] = portInputRegister(digitalPinToPort(pin));
     toggle_mask[i] = digitalPinToBitMask(pin);
   }

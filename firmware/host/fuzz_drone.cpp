@@ -58,6 +58,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     d.update(now);
     const drone::State s = d.state();
+    // Off the ground, the only way down is the landing routine: never straight from flight to disarming.
+    if (s == drone::State::Disarming && (before == drone::State::HoldAltitude || before == drone::State::Moving))
+      fail("disarmed in the air", now, d);
     // A movement starts, or restarts its hold, with an accepted move or turn.
     if (s == drone::State::Moving && (before != drone::State::Moving || stick_frame)) moving_since = now;
     before = s;
@@ -85,8 +88,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
          s == drone::State::Disarming || s == drone::State::SelfTest) &&
         o.throttle != dp::channel_limits(dp::Target::Throttle).min)
       fail("throttle above minimum on the ground", now, d);
-    // Armed only through an arm frame; sticks move only when armed.
-    if (d.armed() && !arm_requested) fail("armed without an arm frame", now, d);
+    // Laser off through every disarm; the landing descends at the throttle's low speed.
+    if (s == drone::State::Disarming && o.laser) fail("laser on while disarming", now, d);
+    if (s == drone::State::Landing && (o.throttle != dp::THROTTLE_LOW || o.mode != dp::MODE_ALT_HOLD_US))
+      fail("landing without alt-hold at low throttle", now, d);
+    // Armed only through an arm frame (the disarm sequence reports `armed` while it runs, even from the
+    // ground, to make sure the flight controller disarms); sticks move only when armed.
+    if (d.armed() && s != drone::State::Disarming && !arm_requested) fail("armed without an arm frame", now, d);
     if ((s == drone::State::Moving || s == drone::State::HoldAltitude) && !d.armed()) fail("flying disarmed", now, d);
     if (s == drone::State::Disarmed && d.armed()) fail("disarmed state but armed", now, d);
     // A movement lasts at most the command timeout.

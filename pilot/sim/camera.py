@@ -16,7 +16,7 @@ import drone_protocol as dp
 import numpy as np
 import numpy.typing as npt
 
-from pilot.sim.room import BGR, Ball, MarkerPlate, Scenario, Vec3
+from .room import BGR, Ball, MarkerPlate, Scenario, Vec3
 
 Image = npt.NDArray[np.uint8]
 FloatArray = npt.NDArray[np.float64]

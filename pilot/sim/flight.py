@@ -15,16 +15,16 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from pilot.config import PilotConfig
-from pilot.controller import Controller, State
-from pilot.detect import make_detector
-from pilot.link import Link, LogEntry, keepalive_ms
-from pilot.record import Recorder
-from pilot.runner import Observer, run
-from pilot.sim.camera import CameraModel
-from pilot.sim.room import make_scenario
-from pilot.sim.virtual import VirtualDrone
-from pilot.sim.world import BOOT_MS, SimWorld
+from ..config import PilotConfig
+from ..controller import Controller, State
+from ..detect import make_detector
+from ..link import Link, LogEntry, keepalive_ms
+from ..record import Recorder
+from ..runner import Observer, run
+from .camera import CameraModel
+from .room import make_scenario
+from .virtual import VirtualDrone
+from .world import BOOT_MS, SimWorld
 
 SUCCESS_LIT_MS = 500  # laser on the target, within reach, for at least this long
 

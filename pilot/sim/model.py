@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from pilot.sim.room import Room
+from .room import Room
 
 
 @dataclass(frozen=True)

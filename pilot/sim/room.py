@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pilot.errors import ConfigError
+from ..errors import ConfigError
 
 Vec3 = tuple[float, float, float]
 BGR = tuple[int, int, int]

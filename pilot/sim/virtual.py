@@ -17,9 +17,9 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import IO, Any
 
-from pilot.closing import Closing
-from pilot.errors import SimulatorError
-from pilot.sim.model import Outputs
+from ..closing import Closing
+from ..errors import SimulatorError
+from .model import Outputs
 
 _TYPES: dict[Any, Any] = {"int": int, "float": float, "bool": bool, int: int, float: float, bool: bool}
 REPO = Path(__file__).resolve().parents[2]

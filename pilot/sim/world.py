@@ -11,13 +11,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from pilot.closing import Closing
-from pilot.errors import FrameSourceError, SimulatorError
-from pilot.sim.camera import CameraModel, CameraPose, Image, Renderer
-from pilot.sim.model import DroneModel, ModelParams, Outputs, StickCentres
-from pilot.sim.room import Scenario
-from pilot.sim.virtual import VirtualDrone
-from pilot.sources import Frame, FrameSourceBase
+from ..closing import Closing
+from ..errors import FrameSourceError, SimulatorError
+from ..sources import Frame, FrameSourceBase
+from .camera import CameraModel, CameraPose, Image, Renderer
+from .model import DroneModel, ModelParams, Outputs, StickCentres
+from .room import Scenario
+from .virtual import VirtualDrone
 
 BOOT_MS = 20  # the firmware boots and sends its ready line (39 bytes at 115200 baud: under 4 ms)
 

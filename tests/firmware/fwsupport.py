@@ -7,13 +7,19 @@ from a constant typed here.
 from __future__ import annotations
 
 import json
+import os
 import subprocess
+import sys
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import drone_protocol as dp
+import yaml
+
+from generator.build import load_spec
+from generator.model import Spec, check_text
 
 ROOT = Path(__file__).resolve().parents[2]
 BUILD = ROOT / "firmware" / "build"
@@ -48,7 +54,119 @@ def neutral() -> dict[str, int]:
 
 def on_ground() -> dict[str, int]:
     """Sticks neutral with the throttle at its minimum: disarmed or armed on the ground."""
-    return {**neutral(), "throttle": dp.CHANNELS["throttle"].minimum}
+    return {**neutral(), "throttle": dp.CHANNELS[dp.ChannelName.THROTTLE].minimum}
+
+
+# --- reply lines, from the spec's model ----------------------------------------------------------------------------
+
+
+class Replies:
+    """Reply lines as the spec defines them (prefixes, error codes, status codes, integrity check).
+
+    Built from the generator's model of a spec file, so the tests need nothing of the Python codec's reply API and
+    work for a copy of the spec (another integrity mode, new commands) as well."""
+
+    def __init__(self, spec: Spec) -> None:
+        self.spec = spec
+
+    def ready(self) -> str:
+        s = self.spec
+        return self._checked(f"{s.reply('ready').prefix} {s.name} {s.short_fingerprint} {s.integrity}")
+
+    def accepted(self, frame: bytes) -> str:
+        """The body of the accepted reply to `frame` (no status)."""
+        return self.spec.reply("accepted").prefix + frame[:2].decode("ascii")
+
+    def rejected(self, error: str) -> str:
+        return self.spec.reply("rejected").prefix + self.spec.error(error).code
+
+    def failsafe(self) -> str:
+        return self.spec.reply("failsafe").prefix
+
+    def line(self, body: str, state: str, laser: bool) -> str:
+        """A whole reply line (no newline): body, status of state `state` (a name) and the laser, check."""
+        st = self.spec.status
+        code = st.state(state).code
+        return self._checked(f"{body}{st.separator}{code}{st.laser_on if laser else st.laser_off}")
+
+    def parse(self, line: str) -> tuple[str, str | None, bool | None]:
+        """(body, state name, laser) of a reply line; the check is verified (crc8) and the status split off."""
+        if self.spec.integrity == "crc8":
+            text, star, check = line.rpartition("*")
+            assert star and check == check_text(text.encode("ascii")), f"bad reply check: {line!r}"
+            line = text
+        if line.startswith(self.spec.reply("ready").prefix):
+            return line, None, None
+        st = self.spec.status
+        body, sep, status = line[:-3], line[-3], line[-2:]
+        assert sep == st.separator and len(status) == 2, f"no status in {line!r}"
+        names = {s.code: s.name for s in st.states}
+        assert status[0] in names and status[1] in (st.laser_on, st.laser_off), f"bad status in {line!r}"
+        return body, names[status[0]], status[1] == st.laser_on
+
+    def body(self, line: str) -> str:
+        return self.parse(line)[0]
+
+    def _checked(self, text: str) -> str:
+        return text + ("*" + check_text(text.encode("ascii")) if self.spec.integrity == "crc8" else "")
+
+
+SPEC = load_spec(ROOT / "spec" / "drone.yaml")
+R = Replies(SPEC)
+
+
+# --- firmware built from a copy of the spec ------------------------------------------------------------------------
+
+
+def python_env() -> dict[str, str]:
+    """The environment for `python -m generator` run from the repository root."""
+    return {**os.environ, "PYTHONPATH": str(ROOT)}
+
+
+def spec_copy() -> dict[str, Any]:
+    """The shipped spec as data, to edit: tests never edit the live spec."""
+    data: dict[str, Any] = yaml.safe_load((ROOT / "spec" / "drone.yaml").read_text(encoding="utf-8"))
+    return data
+
+
+@dataclass(frozen=True)
+class Built:
+    """The AVR firmware and the virtual drone built from a regenerated copy of the spec."""
+
+    spec: Spec
+    library: Path
+    uno_elf: Path
+    virtual_drone: Path
+
+    @property
+    def replies(self) -> Replies:
+        return Replies(self.spec)
+
+    def wire(self, frame: bytes) -> bytes:
+        """A frame as it goes on the wire: with its check in crc8 mode."""
+        return frame + (check_text(frame).encode("ascii") if self.spec.integrity == "crc8" else b"")
+
+    def frame(self, command: str, value: int) -> bytes:
+        """The wire bytes of `command` (its name in this spec) with `value`."""
+        (cmd,) = [c for c in self.spec.commands if c.direction.command == command]
+        return self.wire(cmd.direction.frame(cmd.category.code, value).encode("ascii"))
+
+
+def build_from_spec(data: dict[str, Any], tmp: Path) -> Built:
+    """Write `data` as a spec in `tmp`, regenerate into `tmp/generated` and build the Uno firmware and the virtual
+    drone against it (`make` with DRONE_PROTOCOL_DIR and FW_BUILD; the Arduino cores are shared)."""
+    spec_path = tmp / "drone.yaml"
+    spec_path.write_text(yaml.safe_dump(data, sort_keys=False, allow_unicode=True), encoding="utf-8")
+    out = tmp / "generated"
+    result = subprocess.run([sys.executable, "-m", "generator", "--spec", str(spec_path), "--out", str(out)],
+                            cwd=ROOT, capture_output=True, text=True, check=False)
+    assert result.returncode == 0, result.stderr
+    library = out / "arduino" / "DroneProtocol"
+    build = tmp / "build"
+    make("firmware-sim")
+    elf, host = build / "uno" / "uno.elf", build / "host" / "virtual_drone"
+    make(str(elf), str(host), DRONE_PROTOCOL_DIR=str(library), FW_BUILD=str(build), FW_CORE_BUILD=str(BUILD))
+    return Built(load_spec(spec_path), library, elf, host)
 
 
 # --- the virtual drone, driven with a stepped clock ------------------------------------------------------------
@@ -63,9 +181,13 @@ class Trace:
     stats: list[dict[str, Any]] = field(default_factory=list)
     end_ms: int = 0
 
-    def replies(self, since_ms: int = 0) -> list[str]:
+    def lines(self, since_ms: int = 0) -> list[str]:
         """Reply lines (without newline) sent at or after `since_ms`."""
         return [line for t, text in self.tx if t >= since_ms for line in text.splitlines()]
+
+    def replies(self, since_ms: int = 0, replies: Replies | None = None) -> list[str]:
+        """Reply bodies (no status, no check) sent at or after `since_ms`; the ready line whole."""
+        return [(replies or R).body(line) for line in self.lines(since_ms)]
 
     def state_at(self, t_ms: int) -> dict[str, Any]:
         """The outputs in force at time t_ms (the last change at or before it)."""
@@ -119,9 +241,9 @@ class Script:
             waited += period_ms
         return self.step(5)  # the last keep-alive is read and answered before the caller goes on
 
-    def run(self) -> Trace:
+    def run(self, binary: Path = VIRTUAL_DRONE) -> Trace:
         result = subprocess.run(
-            [str(VIRTUAL_DRONE), "--stdin", "--clock", "stepped"],
+            [str(binary), "--stdin", "--clock", "stepped"],
             input="\n".join(self.lines) + "\n",
             capture_output=True,
             text=True,
@@ -157,12 +279,20 @@ class SimResult:
         lo, hi = start_ms * 16000, end_ms * 16000
         return [w / CYCLES_PER_US for rise, w in self.pulses.get(pin, []) if lo <= rise < hi]
 
-    def replies(self) -> list[str]:
+    def lines(self) -> list[str]:
+        """Reply lines (without newline)."""
         return [line for _, text in self.tx for line in text.splitlines()]
 
-    def replies_between(self, start_ms: float, end_ms: float) -> list[str]:
+    def lines_between(self, start_ms: float, end_ms: float) -> list[str]:
         lo, hi = start_ms * 16000, end_ms * 16000
         return [line for t, text in self.tx if lo <= t < hi for line in text.splitlines()]
+
+    def replies(self, replies: Replies | None = None) -> list[str]:
+        """Reply bodies (no status, no check); the ready line whole."""
+        return [(replies or R).body(line) for line in self.lines()]
+
+    def replies_between(self, start_ms: float, end_ms: float, replies: Replies | None = None) -> list[str]:
+        return [(replies or R).body(line) for line in self.lines_between(start_ms, end_ms)]
 
     def laser_at(self, t_ms: float) -> int:
         level = 0

@@ -20,6 +20,7 @@ def test_outputs_are_clamped_to_the_recorded_extremes_even_past_the_parser(tmp_p
             f"-I{fw.ROOT / 'generated' / 'arduino' / 'DroneProtocol' / 'src'}",
             str(Path(__file__).with_name("logic_probe.cpp")),
             str(fw.ROOT / "firmware" / "drone" / "drone_logic.cpp"),
+            str(fw.ROOT / "firmware" / "drone" / "drone_handlers.cpp"),
             "-o", str(exe),
         ],
         check=True,
@@ -40,4 +41,5 @@ def test_outputs_are_clamped_to_the_recorded_extremes_even_past_the_parser(tmp_p
         assert out[case][channel] == getattr(limits, end), case
         others = {k: v for k, v in out[case].items() if k != channel}
         assert others == {k: v for k, v in fw.neutral().items() if k != channel}, case
-    assert out["servo_far"] == {"pan": dp.SERVOS["pan"].maximum, "tilt": dp.SERVOS["tilt"].minimum}
+    pan, tilt = dp.SERVOS[dp.ServoName.PAN], dp.SERVOS[dp.ServoName.TILT]
+    assert out["servo_far"] == {"pan": pan.maximum, "tilt": tilt.minimum}

@@ -1,74 +1,160 @@
-"""The "build the firmware from generated sources" path end to end: edit the spec (add a direction),
-regenerate into a temporary folder, rebuild the AVR firmware against it, and fly the new command in simavr.
-No firmware source is touched: the new direction reaches the generic move handler through dispatch().
+"""Every spec edit a user can make builds and runs with no hand edit outside spec/: a COPY of the spec gets a new
+category (c camera, direction p, a 0-9999 field), a new direction (mg glide_forward on pitch), a new init routine
+(iz zoom) and a renamed direction (turn l: left -> ccw); it is regenerated into a temporary folder, and the real AVR
+firmware and the virtual drone are built from it. Directions of existing categories reach their category's
+handler; a category or routine the firmware has no handler for is answered `unsupported` (Eu) until one is
+written. Then the same with frame.integrity crc8.
 """
 
 from __future__ import annotations
 
-import re
-import subprocess
-import sys
-from pathlib import Path
+from typing import Any
 
 import drone_protocol as dp
 import fwsupport as fw
-import yaml
+import pytest
 
-NEW_DIRECTION = "g"  # a "glide forward" on the pitch channel, unknown to the committed spec
-NEW_FRAME = b"mg1700"
+from generator.model import check_text
+
+SLOT_MS = 60  # one frame per slot: new pulses start at the next 20 ms output frame
 
 
-def test_a_direction_added_to_the_spec_is_accepted_by_the_rebuilt_firmware(tmp_path: Path) -> None:
-    spec = yaml.safe_load((fw.ROOT / "spec" / "drone.yaml").read_text())
-    directions = spec["categories"]["m"]["directions"]
-    assert NEW_DIRECTION not in directions
-    directions[NEW_DIRECTION] = {
-        "name": "glide_forward",
-        "description": "Glide forward",
-        "channel": "pitch",
-        "default": "high",
+def edited_spec() -> dict[str, Any]:
+    data = fw.spec_copy()
+    data["fields"]["frames"] = {"width": 4, "unit": "none", "parameter": "count", "range": [0, 9999],
+                              "description": "Frames to take"}
+    assert "c" not in data["categories"]
+    data["categories"]["c"] = {
+        "name": "camera", "hardware": "Camera", "description": "Camera commands.", "field": "frames",
+        "directions": {"p": {"name": "photo", "description": "Take photos"}},
     }
-    spec_path = tmp_path / "drone.yaml"
-    spec_path.write_text(yaml.safe_dump(spec, sort_keys=False, allow_unicode=True))
-    out = tmp_path / "generated"
-    subprocess.run(
-        [sys.executable, "-m", "generator", "--spec", str(spec_path), "--out", str(out)], cwd=fw.ROOT, check=True
-    )
-    library = out / "arduino" / "DroneProtocol"
-    header = (library / "src" / "DroneProtocol.h").read_text()
-    assert "'m', 'g'" in header
-    build = tmp_path / "build"
-    fw.make("firmware-sim")  # the simavr harness, which this test may be the first to need
-    # Cores are shared with the main build (FW_CORE_BUILD): only the sketch is rebuilt.
-    fw.make(
-        str(build / "uno" / "uno.elf"),
-        DRONE_PROTOCOL_DIR=str(library),
-        FW_BUILD=str(build),
-        FW_CORE_BUILD=str(fw.BUILD),
-    )
+    moves = data["categories"]["m"]["directions"]
+    assert "g" not in moves
+    moves["g"] = {"name": "glide_forward", "description": "Glide forward", "channel": "pitch", "default": "high"}
+    routines = data["categories"]["i"]["directions"]
+    assert "z" not in routines
+    routines["z"] = {"name": "zoom", "description": "Zooms the camera", "routine": "zoom()"}
+    data["categories"]["t"]["directions"]["l"]["name"] = "ccw"
+    return data
 
-    fingerprint = re.search(r'SPEC_FINGERPRINT\[\] = "([0-9a-f]+)"', header)
-    assert fingerprint and fingerprint.group(1) != dp.SPEC_FINGERPRINT
 
-    # Arm (with keep-alives), then the new command, then check pitch and the reply.
-    events: list[tuple[float, bytes]] = [(50.0, dp.arm())]
-    events += [(50.0 + 300 * k, dp.servo_reset()) for k in range(1, 8)]
-    t = 50.0 + dp.ARMING_HOLD_MS + 150
-    events.append((t, NEW_FRAME))
-    new = fw.simulate(events, t + 60, elf=build / "uno" / "uno.elf")
-    assert new.replies()[0] == f"#READY {dp.PROTOCOL_NAME} {fingerprint.group(1)}"
-    assert new.replies_between(t, t + 60) == ["Amg"]
-    pitch = new.widths_us(fw.PINS["pitch"], t + 25, t + 60)
-    assert pitch and all(abs(w - 1700) <= 2 for w in pitch), pitch
-    others = {name: new.widths_us(fw.PINS[name], t + 25, t + 60) for name in ("roll", "throttle", "yaw")}
-    assert all(w and all(abs(x - fw.neutral()[name]) <= 2 for x in w) for name, w in others.items()), others
+@pytest.fixture(scope="module")
+def edited(tmp_path_factory: pytest.TempPathFactory) -> fw.Built:
+    return fw.build_from_spec(edited_spec(), tmp_path_factory.mktemp("edited"))
 
-    # The firmware built from the committed spec refuses the same frame as a bad direction (armed or not:
-    # the parser rejects it before any state is consulted).
-    fw.make("firmware-uno")
-    old = fw.simulate([(50.0, NEW_FRAME)], 100)
-    refused = old.replies_between(50, 100)
-    assert refused[0] == dp.rejected_line(dp.ErrorKind.BAD_DIRECTION).decode().rstrip()
-    assert not [r for r in refused if r.startswith("A")]  # the parser slides on over "1700": no frame in it
-    pitch_old = old.widths_us(fw.PINS["pitch"], 75, 100)
-    assert pitch_old and all(abs(w - fw.on_ground()["pitch"]) <= 2 for w in pitch_old)
+
+def plan(built: fw.Built) -> tuple[list[tuple[int, bytes]], list[str]]:
+    """(time ms, wire bytes) after arming, and the reply lines they must get."""
+    r = built.replies
+    sends = [
+        (built.frame("camera_photo", 42), r.line(r.rejected("unsupported"), "armed", False)),
+        (built.frame("zoom", 0), r.line(r.rejected("unsupported"), "armed", False)),
+        (built.frame("move_glide_forward", 1700), r.line("Amg", "moving", False)),
+        (built.frame("turn_ccw", 1424), r.line("Atl", "moving", False)),
+    ]
+    return [(SLOT_MS * k, frame) for k, (frame, _) in enumerate(sends)], [line for _, line in sends]
+
+
+def test_the_edited_spec_generates_a_handler_less_dispatch_fallback(edited: fw.Built) -> None:
+    dispatch = (edited.library / "src" / "DroneProtocol_dispatch.h").read_text()
+    assert "call_camera" in dispatch and "Error::Unsupported" in dispatch
+    assert edited.spec.short_fingerprint != dp.SPEC_FINGERPRINT
+
+
+def test_new_frames_in_the_virtual_drone(edited: fw.Built) -> None:
+    script = fw.Script()
+    script.send(edited.frame("arm", 0)).step(1)
+    for _ in range(11):
+        script.step(200).send(edited.frame("servo_reset", 0))
+    t0 = script.step(5).t_ms
+    sends, expected = plan(edited)
+    for t, frame in sends:
+        script.step(t - (script.t_ms - t0)).send(frame)
+    trace = script.step(20).run(binary=edited.virtual_drone)
+    assert trace.lines()[0] == edited.replies.ready()
+    assert trace.lines(since_ms=t0) == expected
+    assert trace.changes[-1]["pitch"] == dp.CHANNELS[dp.ChannelName.PITCH].median  # the turn ended the glide
+    assert trace.changes[-1]["yaw"] == 1424
+    assert any(c["pitch"] == 1700 for c in trace.changes)
+
+
+def test_new_frames_in_simavr(edited: fw.Built) -> None:
+    events: list[tuple[float, bytes]] = [(50.0, edited.frame("arm", 0))]
+    events += [(50.0 + 300 * k, edited.frame("servo_reset", 0)) for k in range(1, 8)]
+    t0 = 50.0 + dp.ARMING_HOLD_MS + 150
+    sends, expected = plan(edited)
+    events += [(t0 + t, frame) for t, frame in sends]
+    end = t0 + sends[-1][0] + SLOT_MS
+    result = fw.simulate(events, end, elf=edited.uno_elf)
+    assert result.lines()[0] == edited.replies.ready()
+    assert result.lines_between(t0, end) == expected
+    glide = result.widths_us(fw.PINS["pitch"], t0 + sends[2][0] + 25, t0 + sends[3][0])
+    assert glide and all(abs(w - 1700) <= 2 for w in glide), glide
+    turn = result.widths_us(fw.PINS["yaw"], t0 + sends[3][0] + 25, end)
+    assert turn and all(abs(w - 1424) <= 2 for w in turn), turn
+
+
+# --- frame.integrity: crc8 ------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def crc8(tmp_path_factory: pytest.TempPathFactory) -> fw.Built:
+    data = fw.spec_copy()
+    data["frame"]["integrity"] = "crc8"
+    return fw.build_from_spec(data, tmp_path_factory.mktemp("crc8"))
+
+
+def corrupt_check(frame: bytes) -> bytes:
+    """The frame with its check digits replaced by another valid pair."""
+    good = frame[-2:]
+    other = check_text(bytes([frame[0] ^ 1]) + frame[1:-2]).encode("ascii")
+    assert other != good
+    return frame[:-2] + other
+
+
+def crc8_plan(built: fw.Built) -> tuple[list[tuple[int, bytes]], list[str]]:
+    r = built.replies
+    ln = built.frame("laser_on", 0)
+    sends = [
+        (ln, r.line(r.accepted(ln), "disarmed", True)),
+        (corrupt_check(built.frame("laser_off", 0)), r.line(r.rejected("bad_check"), "disarmed", True)),
+        (built.frame("laser_off", 0), r.line(r.accepted(ln[:1] + b"f"), "disarmed", False)),
+        (built.frame("arm", 0)[:-1] + b"x", r.line(r.rejected("bad_check"), "disarmed", False)),
+        (built.frame("servo_right", 10), r.line("Asr", "disarmed", False)),
+        (built.frame("servo_right", 10)[:6], ""),  # a seed frame without its check is not a frame
+    ]
+    return [(30 * k, frame) for k, (frame, _) in enumerate(sends)], [line for _, line in sends if line]
+
+
+def without_slides(built: fw.Built, lines: list[str]) -> list[str]:
+    """The lines but the bad_category rejections that follow a bad check while the parser slides past the rest of
+    the refused frame (answered once per kind of error)."""
+    out: list[str] = []
+    for line in lines:
+        body = built.replies.body(line)
+        if body == built.replies.rejected("bad_category"):
+            assert out and built.replies.body(out[-1]) == built.replies.rejected("bad_check"), lines
+            continue
+        out.append(line)
+    return out
+
+
+def test_crc8_ready_line_and_checked_frames_in_the_virtual_drone(crc8: fw.Built) -> None:
+    assert crc8.replies.ready().split("*")[0].endswith(" crc8")
+    script = fw.Script().step(5)
+    sends, expected = crc8_plan(crc8)
+    for t, frame in sends:
+        script.step(t + 5 - script.t_ms).send(frame)
+    trace = script.step(60).run(binary=crc8.virtual_drone)
+    assert trace.lines()[0] == crc8.replies.ready()
+    assert without_slides(crc8, trace.lines(since_ms=5)) == expected
+    assert trace.changes[-1]["pan"] == dp.SERVOS[dp.ServoName.PAN].default + 10
+    assert trace.changes[-1]["laser"] is False
+
+
+def test_crc8_in_simavr(crc8: fw.Built) -> None:
+    sends, expected = crc8_plan(crc8)
+    result = fw.simulate([(50.0 + t, frame) for t, frame in sends], 50.0 + sends[-1][0] + 40, elf=crc8.uno_elf)
+    assert result.lines()[0] == crc8.replies.ready()
+    assert without_slides(crc8, result.lines()[1:]) == expected
+    assert result.laser_at(50.0 + sends[1][0] + 5) == 1 and result.laser_at(50.0 + sends[2][0] + 5) == 0

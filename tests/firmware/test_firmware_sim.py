@@ -39,8 +39,8 @@ class Model:
 
     sticks: dict[str, int] = field(default_factory=fw.on_ground)
     mode: int = dp.MODE_STABILIZE_US
-    pan: int = dp.SERVOS["pan"].default
-    tilt: int = dp.SERVOS["tilt"].default
+    pan: int = dp.SERVOS[dp.ServoName.PAN].default
+    tilt: int = dp.SERVOS[dp.ServoName.TILT].default
     laser: bool = False
 
     def widths(self) -> dict[str, int]:
@@ -104,7 +104,7 @@ def test_every_valid_vector_gives_its_pulses_and_reply() -> None:
         plan.check(
             {**fw.neutral(), spec.target: v["value"], "mode": model.mode},
             None,
-            [reply(dp.accepted_line(dp.decode(frame)))],
+            [fw.R.accepted(frame)],
             v["frame"],
         )
         plan.wait(SLOT_MS)
@@ -115,55 +115,63 @@ def test_every_valid_vector_gives_its_pulses_and_reply() -> None:
         spec = dp.COMMANDS[v["command"]]
         frame = bytes.fromhex(v["frame_hex"])
         if spec.target == "both":
-            model.pan, model.tilt = dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default
+            model.pan, model.tilt = dp.SERVOS[dp.ServoName.PAN].default, dp.SERVOS[dp.ServoName.TILT].default
         else:
             limits = dp.SERVOS[spec.target]
             now = getattr(model, spec.target)
             setattr(model, spec.target, max(limits.minimum, min(limits.maximum, now + spec.sense * v["value"])))
         plan.send(frame)
-        plan.check(model.widths(), model.laser, [reply(dp.accepted_line(dp.decode(frame)))], v["frame"])
+        plan.check(model.widths(), model.laser, [fw.R.accepted(frame)], v["frame"])
         plan.wait(SLOT_MS)
+    laser_after = {"laser_on": True, "laser_off": False}  # the toggle inverts it
     for v in by_category["l"]:
         frame = bytes.fromhex(v["frame_hex"])
-        model.laser = not model.laser
+        model.laser = laser_after.get(v["command"], not model.laser)
         plan.send(frame)
-        plan.check(model.widths(), model.laser, [reply(dp.accepted_line(dp.decode(frame)))], v["frame"])
+        plan.check(model.widths(), model.laser, [fw.R.accepted(frame)], v["frame"])
         plan.wait(SLOT_MS)
     init = {v["command"]: bytes.fromhex(v["frame_hex"]) for v in by_category["i"]}
     assert set(init) == {"arm", "disarm", "hold_altitude", "first_test", "land"}, \
         "a new init routine needs a check here"
     plan.send(init["hold_altitude"])
-    plan.check(model.widths(), model.laser, [reply(dp.accepted_line(dp.decode(init["hold_altitude"])))], "is")
+    plan.check(model.widths(), model.laser, [fw.R.accepted(init["hold_altitude"])], "is")
     plan.wait(SLOT_MS)
     plan.send(init["arm"])  # already armed: accepted, nothing changes
-    plan.check(model.widths(), model.laser, [reply(dp.accepted_line(dp.decode(init["arm"])))], "ia armed")
+    plan.check(model.widths(), model.laser, [fw.R.accepted(init["arm"])], "ia armed")
     plan.wait(SLOT_MS)
     plan.send(init["first_test"])  # never while armed
-    plan.check(model.widths(), model.laser, [reply(dp.rejected_line(dp.ErrorKind.BUSY))], "it armed")
+    plan.check(model.widths(), model.laser, [fw.R.rejected("armed")], "it armed")
     plan.wait(SLOT_MS)
-    plan.send(init["disarm"])
-    model.sticks = {**fw.on_ground(), "yaw": dp.CHANNELS["yaw"].minimum}
+    plan.send(init["disarm"])  # in the air: refused, land instead
+    plan.check(model.widths(), model.laser, [fw.R.rejected("airborne")], "ik airborne")
+    plan.wait(SLOT_MS)
+    plan.send(init["land"])  # alt-hold, throttle at its low speed for the landing time
+    model.sticks = {**fw.neutral(), "throttle": dp.CHANNELS[dp.ChannelName.THROTTLE].low}
+    plan.check(model.widths(), model.laser, [fw.R.accepted(init["land"])], "il")
+    for k in range(1, (fw.SPEC.landing_ms + dp.ARMING_HOLD_MS) // 300 + 1):
+        plan.send(init["land"], dt=300.0 * k)  # il0000 is the keep-alive while landing
+    plan.wait(fw.SPEC.landing_ms + 150)
+    model.sticks = {**fw.on_ground(), "yaw": dp.CHANNELS[dp.ChannelName.YAW].minimum}  # then the disarm sequence
     model.mode = dp.MODE_STABILIZE_US
-    plan.check(model.widths(), model.laser, [reply(dp.accepted_line(dp.decode(init["disarm"])))], "ik")
-    for k in range(1, 8):
-        plan.send(dp.servo_reset(), dt=300.0 * k)
-    plan.wait(dp.ARMING_HOLD_MS + 150)
+    model.laser = False
+    plan.check(model.widths(), model.laser, [fw.R.accepted(init["land"])], "disarming")
+    plan.wait(dp.ARMING_HOLD_MS)
     model.sticks = fw.on_ground()
     plan.check(model.widths(), model.laser, [], "disarmed")
     plan.wait(SLOT_MS)
     plan.send(init["first_test"])  # disarmed: the self-test starts by moving the pan servo to its minimum
     plan.check(
-        {**fw.on_ground(), "pan": fw.servo_us(dp.SERVOS["pan"].minimum)},
+        {**fw.on_ground(), "pan": fw.servo_us(dp.SERVOS[dp.ServoName.PAN].minimum)},
         None,
-        [reply(dp.accepted_line(dp.decode(init["first_test"])))],
+        [fw.R.accepted(init["first_test"])],
         "it disarmed",
     )
     plan.wait(SLOT_MS)
     result = fw.simulate(plan.events, plan.t)
     assert result.end["unsent"] == 0
-    assert reply(dp.ready_line()) == result.replies()[0]
+    assert fw.R.ready() == result.replies()[0]
     verify(result, plan)
-    assert reply(dp.failsafe_line()) not in result.replies()
+    assert fw.R.failsafe() not in result.replies()
 
 
 def test_every_malformed_vector_changes_no_output() -> None:
@@ -183,14 +191,14 @@ def test_every_malformed_vector_changes_no_output() -> None:
             continue
         plan.send(keepalive)
         plan.send(frame, dt=5.0)
-        expected = [reply(dp.accepted_line(dp.decode(keepalive)))]
+        expected = [fw.R.accepted(keepalive)]
         kind = dp.ErrorKind[v["error"].upper()]
         if kind == dp.ErrorKind.TOO_SHORT:
             if frame:
                 # A stream parser cannot know a frame is short until the next byte comes too late.
-                follow_ups.append((plan.t + slot, reply(dp.rejected_line(dp.ErrorKind.TIMEOUT))))
+                follow_ups.append((plan.t + slot, fw.R.rejected("timeout")))
         else:
-            expected.append(reply(dp.rejected_line(kind)))
+            expected.append(fw.R.rejected(kind.name.lower()))
         plan.checks.append((plan.t, plan.t + slot, model.widths(), model.laser, expected, v["frame"]))
         plan.t += slot
     result = fw.simulate(plan.events, plan.t + slot)
@@ -202,12 +210,12 @@ def test_every_malformed_vector_changes_no_output() -> None:
         # A rejected frame can leave a valid-looking tail in the parser ("ml0999" -> "l0999"), which the next
         # byte, 35 ms later, drops as a timeout: that "Et" may open the following slot.
         got = result.replies_between(start, end)
-        got = got[1:] if got and got[0] == reply(dp.rejected_line(dp.ErrorKind.TIMEOUT)) else got
+        got = got[1:] if got and got[0] == fw.R.rejected("timeout") else got
         assert got[: len(replies)] == replies, f"{label}: {got}"
         assert [r for r in got if r.startswith("A")] == [replies[0]], f"{label}: {got}"
     for t, first in follow_ups:
         assert result.replies_between(t, t + 10)[0] == first
-    assert reply(dp.failsafe_line()) not in result.replies()
+    assert fw.R.failsafe() not in result.replies()
 
 
 def test_too_long_frame_on_the_stream_is_a_frame_and_a_stray_byte() -> None:
@@ -219,7 +227,7 @@ def test_too_long_frame_on_the_stream_is_a_frame_and_a_stray_byte() -> None:
     result = fw.simulate(plan.events, plan.t + 40)
     head = dp.decode(frame[:6])
     replies = result.replies_between(plan.t, plan.t + 40)
-    assert replies == [reply(dp.accepted_line(head)), reply(dp.rejected_line(dp.ErrorKind.BAD_CATEGORY))]
+    assert replies == [fw.R.accepted(head.encode()), fw.R.rejected("bad_category")]
     target = dp.COMMANDS[head.name].target
     assert all(abs(w - head.value) <= TOLERANCE_US for w in result.widths_us(fw.PINS[target], plan.t + 25, plan.t + 40))
 
@@ -229,7 +237,7 @@ def test_failsafe_fires_at_its_time_on_the_real_binary() -> None:
     events = [(last_frame_ms, dp.laser_toggle())]
     end = last_frame_ms + dp.FAILSAFE_TIMEOUT_MS + 100
     result = fw.simulate(events, end)
-    (t_fs,) = [t for t, text in result.tx if text == dp.failsafe_line().decode()]
+    (t_fs,) = [t for t, text in result.tx if fw.R.body(text.rstrip("\n")) == fw.R.failsafe()]
     frame_done_ms = last_frame_ms + len(dp.laser_toggle()) * 10_000 / dp.BAUD  # 10 bits per byte
     fired_ms = t_fs / 16000
     # millis() ticks every 1.024 ms on a 16 MHz AVR: the deadline is met to within its resolution.
@@ -238,7 +246,7 @@ def test_failsafe_fires_at_its_time_on_the_real_binary() -> None:
     throttle = fw.PINS["throttle"]
     before = result.widths_us(throttle, last_frame_ms, fired_ms - 1)
     after = result.widths_us(throttle, fired_ms + 21, end)
-    assert before and all(abs(w - dp.CHANNELS["throttle"].minimum) <= TOLERANCE_US for w in before)
+    assert before and all(abs(w - dp.CHANNELS[dp.ChannelName.THROTTLE].minimum) <= TOLERANCE_US for w in before)
     assert after and all(abs(w - dp.FAILSAFE_THROTTLE_US) <= TOLERANCE_US for w in after)
     for name in ("roll", "pitch", "yaw"):
         seen = result.widths_us(fw.PINS[name], fired_ms + 21, end)
@@ -250,7 +258,7 @@ def test_garbage_between_frames_never_changes_an_output_to_an_uncommanded_value(
     plan, model = Plan(), Model()
     arm(plan, model)
     commanded: dict[str, set[int]] = {name: {fw.neutral()[name], fw.on_ground()[name]} for name in fw.STICKS}
-    commanded["yaw"].add(dp.CHANNELS["yaw"].maximum)  # the arming hold
+    commanded["yaw"].add(dp.CHANNELS[dp.ChannelName.YAW].maximum)  # the arming hold
     frames_sent: list[bytes] = []
     sticks = [s for s in dp.COMMANDS.values() if s.category in (dp.Category.MOVE, dp.Category.TURN)]
     for _ in range(60):
@@ -270,9 +278,9 @@ def test_garbage_between_frames_never_changes_an_output_to_an_uncommanded_value(
         assert not stray, f"{name}: uncommanded widths {sorted(set(stray))[:5]}"
     assert result.laser_at(plan.t + 50) == 0 and not result.levels, "the laser was never commanded"
     accepted = [r for r in result.replies() if r.startswith("A")]
-    expected = [reply(dp.accepted_line(dp.decode(f))) for f in frames_sent]
+    expected = [fw.R.accepted(f) for f in frames_sent]
     assert accepted[-len(expected) :] == expected  # every frame found, nothing else accepted
-    assert reply(dp.failsafe_line()) not in result.replies()
+    assert fw.R.failsafe() not in result.replies()
 
 
 def test_pulse_jitter_stays_within_tolerance_under_back_to_back_frames() -> None:
@@ -282,8 +290,14 @@ def test_pulse_jitter_stays_within_tolerance_under_back_to_back_frames() -> None
     for k in range(1500):  # about 0.8 s of frames back to back at full line rate
         plan.events.append((100 + k * per_frame_ms, frame))
     result = fw.simulate(plan.events, 1000)
-    # every frame was parsed and answered while the pulses ran
-    assert result.replies().count(reply(dp.accepted_line(dp.decode(frame)))) == 1500
+    # every frame was parsed and acted on while the pulses ran: the laser toggled 1500 times
+    toggles = sum(1 for (_, a), (_, b) in itertools.pairwise(result.levels) if a != b)
+    assert toggles >= 1500 - 1 and result.laser_at(1000) == 0
+    # A reply (with its status) is longer than a frame: back to back, the transmit line limits the replies and
+    # the rest are dropped, never waited on.
+    reply_bytes = len(fw.R.line(fw.R.accepted(frame), "disarmed", False)) + 1
+    answered = result.replies().count(fw.R.accepted(frame))
+    assert 0.95 * 1500 * len(frame) / reply_bytes <= answered <= 1500
     for name, pin in fw.PINS.items():
         widths = result.widths_us(pin, 150, 950)
         assert len(widths) >= 35, name
@@ -294,12 +308,12 @@ def test_mega_2560_build_drives_the_same_arduino_pins() -> None:
     result = fw.simulate(
         [(50, dp.laser_toggle() + dp.servo_right(45))], 200, elf=fw.BUILD / "mega" / "mega.elf", mcu="atmega2560"
     )
-    assert result.replies()[:3] == [reply(dp.ready_line()), "Al0", "Asr"]
+    assert result.replies()[:3] == [fw.R.ready(), fw.R.accepted(dp.laser_toggle()), fw.R.accepted(dp.servo_right(45))]
     expected = {
         **fw.on_ground(),
         "mode": dp.MODE_STABILIZE_US,
-        "pan": fw.servo_us(dp.SERVOS["pan"].default + 45),
-        "tilt": fw.servo_us(dp.SERVOS["tilt"].default),
+        "pan": fw.servo_us(dp.SERVOS[dp.ServoName.PAN].default + 45),
+        "tilt": fw.servo_us(dp.SERVOS[dp.ServoName.TILT].default),
     }
     for name, want in expected.items():
         seen = result.widths_us(fw.PINS[name], 100, 200)
@@ -330,4 +344,4 @@ def test_ppm_build_sends_the_rc_channels_as_one_ppm_sum_train() -> None:
     for name in ("pitch", "throttle", "yaw", "mode"):
         assert fw.PINS[name] not in result.pulses, name  # parallel outputs are silent in the PPM build
     pan = result.widths_us(fw.PINS["pan"], 100, 300)
-    assert pan and all(abs(w - fw.servo_us(dp.SERVOS["pan"].default - 30)) <= TOLERANCE_US for w in pan)
+    assert pan and all(abs(w - fw.servo_us(dp.SERVOS[dp.ServoName.PAN].default - 30)) <= TOLERANCE_US for w in pan)

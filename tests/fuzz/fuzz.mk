@@ -20,7 +20,7 @@ FUZZ_ARGS = -dict=protocol.dict -artifact_prefix=artifacts/ -max_len=256 -timeou
             -print_final_stats=1
 FUZZ_ENV := ASAN_OPTIONS=abort_on_error=1:detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 
-$(FUZZ_BIN): tests/fuzz/fuzz_stream_parser.cpp $(FUZZ_HEADER) tests/fuzz/fuzz.mk | $(APT_STAMP)
+$(FUZZ_BIN): tests/fuzz/fuzz_stream_parser.cpp $(wildcard $(dir $(FUZZ_HEADER))*.h) tests/fuzz/fuzz.mk | $(APT_STAMP)
 	@mkdir -p $(@D)
 	$(FUZZ_CXX) $(FUZZ_CXXFLAGS) -I$(dir $(FUZZ_HEADER)) $< -o $@
 

@@ -7,8 +7,8 @@
 // Invariants checked (a failure aborts, which libFuzzer reports as a crash):
 // - the parser agrees after every byte with a small reference model written from the spec's rules (same frames,
 //   same pending bytes, same error counts by kind);
-// - pending() <= FRAME_LENGTH - 1; a frame is emitted only when its last byte arrives, and it is exactly the
-//   last FRAME_LENGTH bytes fed;
+// - pending() <= WIRE_LENGTH - 1; a frame is emitted only when its last byte arrives, and it is exactly the
+//   last WIRE_LENGTH bytes fed (the frame and, with integrity crc8, its check);
 // - every emitted or decoded command lies in its command's range, matches its CommandInfo and re-encodes to
 //   the same bytes; encode() succeeds exactly for values in range, and its frame decodes back;
 // - error_name()/error_code() are total.
@@ -32,7 +32,7 @@ namespace {
 
 // The command with these two bytes, by a plain scan of command_info() (independent of the parser's tables).
 int find(uint8_t category, uint8_t direction) {
-  for (uint8_t i = 0; i < COMMAND_COUNT; ++i) {
+  for (CommandIndex i = 0; i < COMMAND_COUNT; ++i) {
     const CommandInfo info = command_info(static_cast<CommandId>(i));
     if (info.category == category && info.direction == direction) return i;
   }
@@ -40,20 +40,38 @@ int find(uint8_t category, uint8_t direction) {
 }
 
 bool is_category(uint8_t byte) {
-  for (uint8_t i = 0; i < COMMAND_COUNT; ++i) {
+  for (CommandIndex i = 0; i < COMMAND_COUNT; ++i) {
     if (command_info(static_cast<CommandId>(i)).category == byte) return true;
   }
   return false;
 }
 
+// CRC-8/SMBUS bit by bit (independent of the header's nibble table).
+uint8_t crc8_bitwise(const uint8_t* data, uint8_t n) {
+  uint8_t crc = 0;
+  for (uint8_t i = 0; i < n; ++i) {
+    crc ^= data[i];
+    for (uint8_t b = 0; b < 8; ++b) crc = static_cast<uint8_t>(crc & 0x80 ? (crc << 1) ^ 0x07 : crc << 1);
+  }
+  return crc;
+}
+
+// The Error value of bad_check (only met with integrity crc8).
+constexpr uint8_t BAD_CHECK = static_cast<uint8_t>(Error::BadCheck);
+
 // The first problem of buf[0..len) read as the start of a frame; Error::None if it may still become one.
 Error first_error(const uint8_t* buf, uint8_t len) {
   if (len >= 1 && !is_category(buf[0])) return Error::BadCategory;
   if (len >= 2 && find(buf[0], buf[1]) < 0) return Error::BadDirection;
-  for (uint8_t i = 2; i < len; ++i) {
+  for (uint8_t i = 2; i < len && i < FRAME_LENGTH; ++i) {
     if (buf[i] < '0' || buf[i] > '9') return Error::BadDigit;
   }
-  if (len == FRAME_LENGTH) {
+  for (uint8_t i = FRAME_LENGTH; i < len; ++i) {
+    const uint8_t crc = crc8_bitwise(buf, FRAME_LENGTH);
+    const uint8_t nibble = i == FRAME_LENGTH ? crc >> 4 : crc & 0x0F;
+    if (buf[i] != "0123456789ABCDEF"[nibble]) return static_cast<Error>(BAD_CHECK);
+  }
+  if (len == WIRE_LENGTH) {
     uint32_t value = 0;
     for (uint8_t i = 2; i < FRAME_LENGTH; ++i) value = value * 10 + (buf[i] - '0');
     const CommandInfo info = command_info(static_cast<CommandId>(find(buf[0], buf[1])));
@@ -64,11 +82,11 @@ Error first_error(const uint8_t* buf, uint8_t len) {
 
 // The reference: the rules of the spec, written plainly (re-check everything after every slide).
 struct Reference {
-  uint8_t buf[FRAME_LENGTH];
+  uint8_t buf[WIRE_LENGTH];
   uint8_t len = 0;
   uint32_t last_ms = 0;
-  uint32_t counts[PARSER_ERROR_COUNT + 1] = {};
-  uint8_t frame[FRAME_LENGTH];
+  uint32_t counts[ERROR_COUNT + 1] = {};
+  uint8_t frame[WIRE_LENGTH];
 
   bool feed(uint8_t byte, uint32_t now) {
     if (len > 0 && now - last_ms > INTER_BYTE_TIMEOUT_MS) {
@@ -80,8 +98,8 @@ struct Reference {
     while (len > 0) {
       const Error e = first_error(buf, len);
       if (e == Error::None) {
-        if (len < FRAME_LENGTH) return false;
-        memcpy(frame, buf, FRAME_LENGTH);
+        if (len < WIRE_LENGTH) return false;
+        memcpy(frame, buf, WIRE_LENGTH);
         len = 0;
         return true;
       }
@@ -93,14 +111,14 @@ struct Reference {
 };
 
 void check_command(const Command& cmd, const uint8_t* bytes) {
-  CHECK(static_cast<uint8_t>(cmd.id) < COMMAND_COUNT);
+  CHECK(static_cast<CommandIndex>(cmd.id) < COMMAND_COUNT);
   const CommandInfo info = command_info(cmd.id);
   CHECK(info.category == cmd.category && info.direction == cmd.direction);
   CHECK(cmd.value >= info.min && cmd.value <= info.max);
   CHECK(command_name(cmd.id) != nullptr && strcmp(command_name(cmd.id), "unknown") != 0);
-  uint8_t again[FRAME_LENGTH];
+  uint8_t again[WIRE_LENGTH];
   CHECK(encode(cmd, again) == Error::None);
-  CHECK(memcmp(again, bytes, FRAME_LENGTH) == 0);
+  CHECK(memcmp(again, bytes, WIRE_LENGTH) == 0);
   Command back{};
   CHECK(decode(again, back) == Error::None);
   CHECK(back.id == cmd.id && back.value == cmd.value && back.category == cmd.category &&
@@ -110,7 +128,7 @@ void check_command(const Command& cmd, const uint8_t* bytes) {
 void fuzz_stream(const uint8_t* data, size_t size) {
   StreamParser parser;
   Reference ref;
-  uint8_t recent[FRAME_LENGTH] = {};  // the last bytes fed, oldest first
+  uint8_t recent[WIRE_LENGTH] = {};  // the last bytes fed, oldest first
   uint32_t now = 0;
   for (size_t i = 0; i < size; ++i) {
     uint8_t byte = data[i];
@@ -121,47 +139,47 @@ void fuzz_stream(const uint8_t* data, size_t size) {
         continue;
       }
     }
-    memmove(recent, recent + 1, FRAME_LENGTH - 1);
-    recent[FRAME_LENGTH - 1] = byte;
+    memmove(recent, recent + 1, WIRE_LENGTH - 1);
+    recent[WIRE_LENGTH - 1] = byte;
     const bool got = parser.feed(byte, now);
     const bool expected = ref.feed(byte, now);
     CHECK(got == expected);
     CHECK(parser.pending() == ref.len);
-    CHECK(parser.pending() <= FRAME_LENGTH - 1);
-    for (uint8_t e = 1; e <= PARSER_ERROR_COUNT; ++e) {
+    CHECK(parser.pending() <= WIRE_LENGTH - 1);
+    for (uint8_t e = 1; e <= ERROR_COUNT; ++e) {
       const uint32_t n = ref.counts[e] > 0xFFFF ? 0xFFFF : ref.counts[e];
       CHECK(parser.error_count(static_cast<Error>(e)) == n);
     }
     if (got) {
       CHECK(parser.pending() == 0);
-      CHECK(memcmp(ref.frame, recent, FRAME_LENGTH) == 0);
+      CHECK(memcmp(ref.frame, recent, WIRE_LENGTH) == 0);
       check_command(parser.command(), recent);
     }
   }
   parser.reset();
   CHECK(parser.pending() == 0);
-  for (uint8_t e = 1; e <= PARSER_ERROR_COUNT; ++e) CHECK(parser.error_count(static_cast<Error>(e)) == 0);
+  for (uint8_t e = 1; e <= ERROR_COUNT; ++e) CHECK(parser.error_count(static_cast<Error>(e)) == 0);
 }
 
 void fuzz_decode(const uint8_t* data, size_t size) {
   Command cmd{};
   const Error whole = decode(data, size, cmd);
-  if (size < FRAME_LENGTH) CHECK(whole == Error::TooShort);
-  if (size > FRAME_LENGTH) CHECK(whole == Error::TooLong);
-  for (size_t at = 0; at + FRAME_LENGTH <= size && at < 64; ++at) {
+  if (size < WIRE_LENGTH) CHECK(whole == Error::TooShort);
+  if (size > WIRE_LENGTH) CHECK(whole == Error::TooLong);
+  for (size_t at = 0; at + WIRE_LENGTH <= size && at < 64; ++at) {
     Command out{};
     const Error e = decode(data + at, out);
-    CHECK(e == first_error(data + at, FRAME_LENGTH));
+    CHECK(e == first_error(data + at, WIRE_LENGTH));
     if (e == Error::None) check_command(out, data + at);
   }
 }
 
 void fuzz_encode(const uint8_t* data, size_t size) {
   for (size_t at = 0; at + 3 <= size && at < 48; at += 3) {
-    const CommandId id = static_cast<CommandId>(data[at] % COMMAND_COUNT);
+    const CommandId id = static_cast<CommandId>((data[at] << 8 | data[at + 1]) % COMMAND_COUNT);
     const uint16_t value = static_cast<uint16_t>(data[at + 1] << 8 | data[at + 2]);
     const CommandInfo info = command_info(id);
-    uint8_t frame[FRAME_LENGTH];
+    uint8_t frame[WIRE_LENGTH];
     const Error e = encode(id, value, frame);
     CHECK((e == Error::None) == (value >= info.min && value <= info.max));
     if (e != Error::None) {
@@ -174,7 +192,7 @@ void fuzz_encode(const uint8_t* data, size_t size) {
     check_command(cmd, frame);
   }
   // A CommandId outside the table is refused, not read out of bounds.
-  uint8_t frame[FRAME_LENGTH];
+  uint8_t frame[WIRE_LENGTH];
   CHECK(encode(static_cast<CommandId>(COMMAND_COUNT), 0, frame) != Error::None);
 }
 
@@ -185,8 +203,11 @@ void fuzz_names(const uint8_t* data, size_t size) {
   const char code = error_code(e);
   CHECK(code >= 0x21 && code <= 0x7E);
   char line[64];
-  const uint8_t n = write_rejected(e, line);
+  const State state = static_cast<State>(size > 1 ? data[1] % STATE_COUNT : 0);
+  const uint8_t n = write_rejected(e, state, size > 2 && (data[2] & 1), line);
   CHECK(n >= 2 && n <= REPLY_MAX_LENGTH && line[n - 1] == '\n');
+  CHECK(state_code(state) != '?');
+  CHECK(strcmp(state_name(state), "unknown") != 0);
 }
 
 }  // namespace

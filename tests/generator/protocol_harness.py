@@ -6,20 +6,26 @@ conftest would be the same module name. Tests import this as `import protocol_ha
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import functools
 import hashlib
 import io
 import os
+import shutil
 import subprocess
 import sys
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 from generator.cli import main as generator_main
 
 ROOT = Path(__file__).resolve().parents[2]
-SPEC = ROOT / "spec" / "drone.yaml"
+SPEC = ROOT / "spec" / "drone.yaml"  # the live spec: only generic checks and the seed pins read it
+# What every spec-edit and malformed-spec test edits: a frozen copy, so a user's edit of the live spec leaves
+# them green.
+FIXTURE = Path(__file__).resolve().parent / "specs" / "drone.yaml"
 GENERATED = ROOT / "generated"
 HEADER = GENERATED / "arduino" / "DroneProtocol" / "src" / "DroneProtocol.h"
 CPP_DIR = Path(__file__).resolve().parent / "cpp"
@@ -27,8 +33,15 @@ BUILD = ROOT / "build" / "tests" / "generator"
 CXXFLAGS = ("-std=c++11", "-Wall", "-Wextra", "-Werror", "-O1")
 
 
+def header_text(include: Path | None = None) -> str:
+    """The generated C++ library: DroneProtocol.h and the parts it includes, as one text."""
+    folder = include or HEADER.parent
+    return "\n".join(p.read_text(encoding="utf-8") for p in sorted(folder.glob("*.h")))
+
+
 def spec_text() -> str:
-    return SPEC.read_text(encoding="utf-8")
+    """The text of the frozen fixture spec (never the live one)."""
+    return FIXTURE.read_text(encoding="utf-8")
 
 
 def edit(text: str, old: str, new: str) -> str:
@@ -80,6 +93,17 @@ def generate_subprocess(*args: str | Path, cwd: Path = ROOT) -> Run:
     return Run(proc.returncode, proc.stdout, proc.stderr)
 
 
+@functools.cache
+def fixture_generated() -> Path:
+    """The fixture spec generated once per test process into a temporary folder (copy it before changing it)."""
+    root = tempfile.mkdtemp(prefix="fixture_generated_")
+    atexit.register(shutil.rmtree, root, True)
+    out = Path(root) / "generated"
+    run = generate("--spec", FIXTURE, "--out", out)
+    assert run.code == 0, run.stderr
+    return out
+
+
 def tree(root: Path) -> dict[str, bytes]:
     """Every file under `root` (relative posix path -> bytes)."""
     return {p.relative_to(root).as_posix(): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
@@ -92,8 +116,8 @@ def compile_cpp(source: Path | str, name: str, include: Path | None = None,
     Executables are cached in build/tests/generator/ by a hash of source, header and flags."""
     include = include or HEADER.parent
     text = source.read_text(encoding="utf-8") if isinstance(source, Path) else source
-    key = hashlib.sha256("\0".join([text, (include / "DroneProtocol.h").read_text(encoding="utf-8"), compiler,
-                                    *flags]).encode()).hexdigest()[:16]
+    headers = [h.read_text(encoding="utf-8") for h in sorted(include.glob("*.h"))]  # the header and its parts
+    key = hashlib.sha256("\0".join([text, *headers, compiler, *flags]).encode()).hexdigest()[:16]
     BUILD.mkdir(parents=True, exist_ok=True)
     exe = BUILD / f"{name}-{key}"
     if exe.exists():

@@ -118,25 +118,37 @@ def test_python_and_cpp_agree_on_a_large_sample_of_6_byte_inputs() -> None:
 
 def test_python_and_cpp_agree_on_every_length() -> None:
     rng = random.Random(7)
-    good = p.move_forward()
+    good = max(p.encode(s.category, s.direction, s.maximum) for s in p.COMMANDS.values())
     frames = [good[:n] for n in range(7)] + [good + b"0", good * 2, b"", rng.randbytes(40)]
     frames += [rng.randbytes(rng.randrange(12)) for _ in range(2000)]
     assert [python_result(f) for f in frames] == cpp_results(frames)
 
 
 def test_both_ends_write_and_read_the_same_reply_lines() -> None:
-    """The Arduino's reply encoders print exactly what the Python reply functions print and parse_reply reads."""
+    """The Arduino's reply encoders print exactly what the Python reply functions print and parse_reply reads.
+
+    The driver cycles the status through the states in spec order and sets the laser at odd indexes."""
     lines = [bytes.fromhex(line) for line in h.run_driver("replies", "")]
+    states = list(p.DroneState)
     commands = [p.decode(p.encode(s.category, s.direction, s.minimum)) for s in p.COMMANDS.values()]
-    expected = [p.ready_line(), *(p.accepted_line(c) for c in commands), *(p.rejected_line(k) for k in p.ErrorKind),
-                p.failsafe_line()]
+    errors = list(p.ErrorKind)
+    accepted = [(c, states[i % len(states)], i % 2 == 1) for i, c in enumerate(commands)]
+    rejected = [(k, states[(i + 1) % len(states)], (i + 1) % 2 == 1) for i, k in enumerate(errors)]
+    failsafe = [(s, i % 2 == 1) for i, s in enumerate(states)]
+    expected = [p.ready_line(), *(p.accepted_line(*a) for a in accepted), *(p.rejected_line(*r) for r in rejected),
+                *(p.failsafe_line(*f) for f in failsafe)]
     assert lines == expected
     ready = p.parse_reply(lines[0])
     assert (ready.kind, ready.protocol, ready.fingerprint) == (p.ReplyKind.READY, p.PROTOCOL_NAME, p.SPEC_FINGERPRINT)
-    for line, cmd in zip(lines[1:1 + len(commands)], commands, strict=True):
+    assert ready.integrity == p.INTEGRITY
+    rest = iter(lines[1:])
+    for (cmd, state, laser), line in zip(accepted, rest, strict=False):
         reply = p.parse_reply(line)
-        assert (reply.kind, reply.category, reply.direction) == (p.ReplyKind.ACCEPTED, cmd.category,
-                                                                 cmd.direction.value)
-    for line, kind in zip(lines[1 + len(commands):-1], p.ErrorKind, strict=True):
-        assert p.parse_reply(line).error is kind
-    assert p.parse_reply(lines[-1]).kind is p.ReplyKind.FAILSAFE
+        assert (reply.kind, reply.category, reply.direction, reply.state, reply.laser) == (
+            p.ReplyKind.ACCEPTED, cmd.category, cmd.direction.value, state, laser)
+    for (kind, state, laser), line in zip(rejected, rest, strict=False):
+        reply = p.parse_reply(line)
+        assert (reply.error, reply.state, reply.laser) == (kind, state, laser)
+    for (state, laser), line in zip(failsafe, rest, strict=False):
+        reply = p.parse_reply(line)
+        assert (reply.kind, reply.state, reply.laser) == (p.ReplyKind.FAILSAFE, state, laser)

@@ -13,6 +13,7 @@ import protocol_harness as h
 
 from generator import __version__
 from generator.build import load_spec
+from generator.names import pascal
 from generator.render import render_all
 
 # Files whose format has no comment syntax carry the header elsewhere (vectors.json: its "generated" member).
@@ -34,9 +35,10 @@ def test_regenerating_into_a_temporary_folder_reproduces_generated_byte_for_byte
 
 def test_the_targets_of_the_issue_are_all_generated() -> None:
     files = set(h.tree(h.GENERATED))
-    for rel in ("python/drone_protocol/__init__.py", "python/drone_protocol/py.typed",
-                "arduino/DroneProtocol/library.properties", "arduino/DroneProtocol/src/DroneProtocol.h",
-                "docs/protocol.md", "vectors.json"):
+    name = load_spec(h.SPEC).name
+    package, library = f"python/{name}", f"arduino/{pascal(name)}"
+    for rel in (f"{package}/__init__.py", f"{package}/py.typed", f"{library}/library.properties",
+                f"{library}/src/{pascal(name)}.h", "docs/protocol.md", "vectors.json", "contract.json"):
         assert rel in files, f"generated/{rel} is missing"
 
 
@@ -48,7 +50,7 @@ def test_check_passes_on_the_repository() -> None:
 
 def test_check_writes_nothing_and_fails_naming_every_stale_file_after_a_spec_edit(tmp_path: Path) -> None:
     out = tmp_path / "generated"
-    shutil.copytree(h.GENERATED, out)
+    shutil.copytree(h.fixture_generated(), out)
     spec = tmp_path / "drone.yaml"
     spec.write_text(h.edited_spec(("        description: Strafe left", "        description: Strafe to the left")))
     before = h.tree(out)
@@ -72,10 +74,12 @@ def test_check_names_a_missing_file(tmp_path: Path) -> None:
 
 def test_check_fails_on_a_hand_edit_of_a_generated_file(tmp_path: Path) -> None:
     out = tmp_path / "generated"
-    shutil.copytree(h.GENERATED, out)
-    header = out / "arduino" / "DroneProtocol" / "src" / "DroneProtocol.h"
-    header.write_bytes(header.read_bytes().replace(b"INTER_BYTE_TIMEOUT_MS = 20;", b"INTER_BYTE_TIMEOUT_MS = 50;"))
-    run = h.generate("--spec", h.SPEC, "--out", out, "--check")
+    shutil.copytree(h.fixture_generated(), out)
+    header = out / "arduino" / "DroneProtocol" / "src" / "DroneProtocol_spec.h"
+    edited = header.read_bytes().replace(b"INTER_BYTE_TIMEOUT_MS = 20;", b"INTER_BYTE_TIMEOUT_MS = 50;")
+    assert edited != header.read_bytes()
+    header.write_bytes(edited)
+    run = h.generate("--spec", h.FIXTURE, "--out", out, "--check")
     assert (run.code, run.stdout.splitlines()) == (1, [f"stale: {header}"])
 
 
@@ -126,16 +130,16 @@ def test_every_generated_file_carries_the_do_not_edit_header_with_the_fingerprin
 
 def test_both_ends_export_the_same_fingerprint() -> None:
     spec = load_spec(h.SPEC)
-    python = (h.GENERATED / "python" / "drone_protocol" / "__init__.py").read_text()
-    header = h.HEADER.read_text()
+    python = (h.GENERATED / "python" / "drone_protocol" / "tables.py").read_text()
+    header = h.header_text()
     assert f'SPEC_FINGERPRINT: Final = "{spec.short_fingerprint}"' in python
     assert f'SPEC_SHA256: Final = "{spec.fingerprint}"' in python
     assert f'constexpr char SPEC_FINGERPRINT[] = "{spec.short_fingerprint}";' in header
-    assert f"#READY drone_protocol {spec.short_fingerprint}\\n" in header
+    assert f'"{spec.reply("ready").prefix} {spec.name} {spec.short_fingerprint} {spec.integrity}' in header
 
 
 def test_the_fingerprint_follows_the_spec_content_not_its_comments_or_layout(tmp_path: Path) -> None:
-    base = load_spec(h.SPEC).fingerprint
+    base = load_spec(h.FIXTURE).fingerprint
     commented = tmp_path / "commented.yaml"
     commented.write_text("# an extra comment\n" + h.spec_text().replace("  length: 6\n", "  length:   6  # six\n"))
     assert load_spec(commented).fingerprint == base
@@ -153,7 +157,8 @@ def test_no_timestamps_or_absolute_paths_in_the_output() -> None:
 
 def test_version_and_the_installed_console_script(tmp_path: Path) -> None:
     run = h.generate("--version")
-    assert run.code == 0 and run.stdout.strip() == f"python -m generator {__version__}"
+    assert run.code == 0 and run.stdout.strip().startswith(f"python -m generator {__version__} (spec ")
+    assert load_spec(h.SPEC).short_fingerprint in run.stdout
     script = Path(sys.executable).parent / "drone-protocol-gen"
     assert script.exists(), "pyproject.toml's console script is not installed in the venv"
     proc = subprocess.run([str(script), "--spec", str(h.SPEC), "--out", str(tmp_path)], capture_output=True,

@@ -72,7 +72,8 @@ CASES = [
          (("sens: 1", "categories.s.directions.u.sens: unknown key 'sens' (hint: did you mean 'sense'?)"),)),
     Case("unknown top-level key lists the known ones", (("# Tables 1, 2, 3, 5 and 6.\n", "notes: hello\n"),),
          (("notes: hello", "notes: unknown key 'notes' (hint: known keys: categories, channels, errors, fields, "
-           "flight_modes, frame, link, protocol, replies, safety, servos, settled, speeds, status)"),)),
+           "flight_modes, frame, link, project, protocol, replies, safety, servos, settled, speeds, status, "
+           "wiring)"),)),
     Case("missing key", (("        name: backward\n", ""),),
          (("description: Backward", "categories.m.directions.b.name: missing key 'name'"),)),
     Case("missing key of a category: no field for its directions",
@@ -285,7 +286,7 @@ def check(case: Case, tmp_path: Path, expected: list[str]) -> None:
     spec = tmp_path / "drone.yaml"
     spec.write_text(case.spec(), encoding="utf-8")
     out = tmp_path / "generated"
-    shutil.copytree(h.GENERATED, out)
+    shutil.copytree(h.fixture_generated(), out)
     before = h.tree(out)
     run = h.generate("--spec", spec, "--out", out)
     count = len(expected)
@@ -331,4 +332,4 @@ def test_an_unreadable_spec_is_an_error_not_a_traceback(tmp_path: Path) -> None:
     binary = tmp_path / "binary.yaml"
     binary.write_bytes(b"\xff\xfe\x00protocol")
     run = h.generate("--spec", binary, "--out", tmp_path / "out")
-    assert run.code == 2 and "cannot read the spec" in run.stderr
+    assert run.code == 2 and "1:1: the spec is not UTF-8 text (byte 0xff)" in run.stderr

@@ -51,14 +51,14 @@ assert p.TurnDirection.HOLD.value == "h"
 
 frame: bytes = p.gripper_open(45)
 assert frame == b"go0045", frame
-assert p.decode(frame) == p.Command(p.Category.GRIPPER, p.GripperDirection.OPEN, 45, "gripper_open")
+assert p.decode(frame) == p.Command(p.Category.GRIPPER, p.GripperDirection.OPEN, 45, p.CommandName.GRIPPER_OPEN)
 assert p.gripper_close() == b"gc0000" and p.decode(b"gc0000").name == "gripper_close"
 assert p.turn_hold() == b"th1524" and p.turn_hold(1035) == b"th1035"
 assert p.encode("t", "h") == b"th1524" and p.encode(p.Category.GRIPPER, "o", 180) == b"go0180"
 held = p.decode(b"th2012")
 assert (held.category, held.direction, held.value) == (p.Category.TURN, p.TurnDirection.HOLD, 2012)
 assert held.name == "turn_hold"
-assert p.COMMANDS["turn_hold"].default == p.CHANNELS["yaw"].median == 1524
+assert p.COMMANDS[p.CommandName.TURN_HOLD].default == p.CHANNELS[p.ChannelName.YAW].median == 1524
 
 for bad, kind in ((b"go0000", p.ErrorKind.OUT_OF_RANGE), (b"go0181", p.ErrorKind.OUT_OF_RANGE),
                   (b"gx0045", p.ErrorKind.BAD_DIRECTION), (b"th1034", p.ErrorKind.OUT_OF_RANGE)):
@@ -165,8 +165,8 @@ def edited(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def test_the_edited_spec_has_a_new_fingerprint(edited: Path) -> None:
-    assert load_spec(edited / "drone.yaml").fingerprint != load_spec(h.SPEC).fingerprint
-    run = h.generate("--spec", edited / "drone.yaml", "--out", h.GENERATED, "--check")  # now stale
+    assert load_spec(edited / "drone.yaml").fingerprint != load_spec(h.FIXTURE).fingerprint
+    run = h.generate("--spec", edited / "drone.yaml", "--out", h.fixture_generated(), "--check")  # now stale
     assert run.code == 1
 
 

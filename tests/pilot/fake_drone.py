@@ -51,7 +51,7 @@ class FakeDrone:
         now = self._now()
         if self.state is not S.FAILSAFE and now - self._last_valid >= dp.FAILSAFE_TIMEOUT_MS:
             self._set(S.FAILSAFE)
-            self._reply(dp.failsafe_line())
+            self._reply(dp.failsafe_line)
             return
         if self._until and now >= self._until:
             nxt = {S.ARMING: S.ARMED, S.MOVING: S.HOLD_ALTITUDE, S.LANDING: S.DISARMING, S.DISARMING: S.DISARMED}
@@ -59,12 +59,13 @@ class FakeDrone:
                 new = nxt[self.state]
                 self._set(new, dp.ARMING_HOLD_MS if new is S.DISARMING else 0)
 
-    def _reply(self, line: bytes) -> None:
+    def _reply(self, line: Callable[[dp.DroneState, bool], bytes]) -> None:
+        """A reply line with the status after the frame (``line`` takes the state and the laser)."""
         if self.drop_replies > 0:
             self.drop_replies -= 1
             return
         if not self.stop_answering:
-            self._out.append(line.rstrip(b"\n") + dp.status_suffix(self.state, self.laser) + b"\n")
+            self._out.append(line(self.state, self.laser))
 
     # -- the Sink -------------------------------------------------------------------------------------
     def send(self, frame: bytes) -> bool:
@@ -76,12 +77,16 @@ class FakeDrone:
         try:
             command = dp.decode(frame)
         except dp.ProtocolError as exc:
-            assert exc.kind is not None
-            self._reply(dp.rejected_line(exc.kind))
+            kind = exc.kind
+            assert kind is not None
+            self._reply(lambda state, laser: dp.rejected_line(kind, state, laser))
             return True
         self._last_valid = self._now()
         error = self._handle(dp.CommandName(command.name))
-        self._reply(dp.rejected_line(error) if error is not None else dp.accepted_line(command))
+        if error is not None:
+            self._reply(lambda state, laser: dp.rejected_line(error, state, laser))
+        else:
+            self._reply(lambda state, laser: dp.accepted_line(command, state, laser))
         return True
 
     def poll(self) -> list[dp.Reply]:

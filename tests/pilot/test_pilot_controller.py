@@ -12,6 +12,7 @@ from fake_drone import FakeDrone
 from pilot.config import ControllerConfig
 from pilot.controller import Controller, State
 from pilot.detect import Detection
+from pilot.detection import range_of
 
 W, H = 320, 240
 CFG = ControllerConfig()
@@ -30,8 +31,10 @@ class Clock:
         self.t += ms / 1000.0
 
 
-def seen(ex: float = 0.0, ey: float = 0.0, size: float = 0.05) -> Detection:
-    return Detection(True, W / 2 + ex * W / 2, H / 2 + ey * H / 2, size * W, 0.95, W, H)
+def seen(ex: float = 0.0, ey: float = 0.0, size: float = 0.05, confidence: float = 0.95) -> Detection:
+    """A measured sighting of the 0.3 m ball, its range from its apparent size."""
+    distance = range_of(size * W, 0.3, W, CFG.horizontal_fov_deg)
+    return Detection(True, W / 2 + ex * W / 2, H / 2 + ey * H / 2, size * W, confidence, W, H, range_m=distance)
 
 
 MISS = Detection(False, width=W, height=H)
@@ -97,7 +100,7 @@ def to_state(state: State, cfg: ControllerConfig = CFG) -> tuple[Controller, Rig
 
 def refusal(error: dp.ErrorKind, state: dp.DroneState) -> dp.Reply:
     """A rejected reply with the drone's status (laser off)."""
-    return dp.parse_reply(dp.rejected_line(error).rstrip(b"\n") + dp.status_suffix(state, False))
+    return dp.parse_reply(dp.rejected_line(error, state, False))
 
 
 def land_to_done(rig: Rig, limit_s: float = 30.0) -> list[str]:
@@ -315,7 +318,9 @@ def test_laser_only_while_locked_and_centred() -> None:
     assert c.laser_on
     out = rig.tick(MISS)  # one missed frame: off at once, still firing
     assert name(out) == "laser_off" and not c.want_laser and st(c) is State.FIRE
-    out = rig.tick(seen(size=0.25))  # re-found and centred: on again
+    for _ in range(CFG.confirm_frames - 1):  # re-found and centred: confirmed again before the laser goes on
+        assert name(rig.tick(seen(size=0.25))) == "hold_altitude" and not c.want_laser
+    out = rig.tick(seen(size=0.25))
     assert name(out) == "laser_on" and c.want_laser
     out = rig.tick(seen(0.3, 0.0, size=0.25))  # off centre: off, back to aiming
     assert name(out) == "laser_off" and not c.want_laser and st(c) is State.AIM

@@ -67,7 +67,7 @@ def test_hsv_both_hue_ranges_are_needed() -> None:
     low_red = bg.copy()
     cv2.circle(low_red, (100, 100), 15, (10, 20, 220), -1)  # hue near 2
     high_red = bg.copy()
-    cv2.circle(high_red, (100, 100), 15, (60, 10, 220), -1)  # hue near 172..176
+    cv2.circle(high_red, (100, 100), 15, (40, 15, 220), -1)  # hue near 176
     hsv_low = cv2.cvtColor(low_red, cv2.COLOR_BGR2HSV)[100, 100]
     hsv_high = cv2.cvtColor(high_red, cv2.COLOR_BGR2HSV)[100, 100]
     assert hsv_low[0] < 10 and hsv_high[0] > 170
@@ -118,21 +118,24 @@ def test_aruco_ignores_other_ids_and_distractors() -> None:
     assert not det.detect(red_only).found
 
 
-def test_lookup_table_path_equals_one_inrange_per_range() -> None:
-    """The fast path (shared S/V bounds, hue by lookup table) gives exactly the mask of one inRange per range."""
+def test_one_inrange_on_the_mirrored_hue_equals_one_inrange_per_range() -> None:
+    """Red's two ranges become one range at hue 120 when the BGR frame is converted as RGB: the same mask,
+    but for pixels whose hue sits on a range boundary (rounding of the mirrored hue)."""
     import numpy as np
 
     cfg = HsvConfig()
     fast = HsvBlobDetector(cfg)
-    assert fast._hue_lut is not None
+    assert fast.single_range
     rng = np.random.default_rng(5)
+    kernel = cv2.getStructuringElement(cv2.MORPH_RECT, (3, 3))
     for _ in range(5):
         img = rng.integers(0, 256, (120, 160, 3), dtype=np.uint8)
         hsv = cv2.cvtColor(img, cv2.COLOR_BGR2HSV)
         reference = np.zeros(hsv.shape[:2], np.uint8)
         for lo, hi in cfg.ranges:
             reference |= cv2.inRange(hsv, np.array(lo, np.uint8), np.array(hi, np.uint8))
-        reference = cv2.morphologyEx(reference, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_RECT, (3, 3)))
-        assert np.array_equal(fast.mask(img), reference)
+        reference = cv2.morphologyEx(cv2.morphologyEx(reference, cv2.MORPH_OPEN, kernel), cv2.MORPH_CLOSE, kernel)
+        differ = fast.mask(img) != reference
+        assert np.count_nonzero(differ) <= 0.01 * differ.size
     general = HsvBlobDetector(HsvConfig(ranges=(((0, 120, 70), (8, 255, 255)), ((172, 100, 70), (179, 255, 255)))))
-    assert general._hue_lut is None
+    assert not general.single_range  # different S bounds: one inRange per range

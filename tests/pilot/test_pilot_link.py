@@ -30,6 +30,8 @@ FRAMES = [
     dp.disarm(),
 ]
 
+# The drone state the fake peer reports in its replies.
+ST = dp.DroneState.ARMED
 OTHER_FINGERPRINT = "f" * len(dp.SPEC_FINGERPRINT)
 
 
@@ -72,7 +74,7 @@ def test_loop_frames_on_the_wire_are_exactly_the_encoder_output() -> None:
 def test_ready_wait_times_out_with_a_clear_message() -> None:
     clock = FakeClock()
     port = serial.serial_for_url("loop://", timeout=0)
-    port.write(dp.accepted_line(dp.decode(dp.arm())))  # a valid reply, but not the ready line
+    port.write(dp.accepted_line(dp.decode(dp.arm()), ST, False))  # a valid reply, but not the ready line
     link = Link(port, ready_timeout_s=2.0, clock=clock, sleep=clock.sleep)
     with pytest.raises(ReadyTimeout, match=r"no ready line .* within 2\.0 s"):
         link.open()
@@ -95,10 +97,10 @@ def test_replies_are_parsed_bounded_and_garbage_is_logged() -> None:
     port.write(dp.ready_line())
     log: list[LogEntry] = []
     link = Link(port, log=log.append).open()
-    port.write(dp.accepted_line(dp.decode(dp.turn_left())))
-    port.write(dp.rejected_line(dp.ErrorKind.NOT_ARMED))
+    port.write(dp.accepted_line(dp.decode(dp.turn_left()), ST, False))
+    port.write(dp.rejected_line(dp.ErrorKind.NOT_ARMED, ST, False))
     port.write(b"?? what\n")
-    port.write(dp.failsafe_line())
+    port.write(dp.failsafe_line(dp.DroneState.FAILSAFE, False))
     replies = link.poll()
     assert [r.kind for r in replies] == [dp.ReplyKind.ACCEPTED, dp.ReplyKind.REJECTED, dp.ReplyKind.FAILSAFE]
     assert replies[0].category is dp.Category.TURN and replies[1].error is dp.ErrorKind.NOT_ARMED
@@ -141,7 +143,8 @@ def test_pty_ready_frames_and_replies(pty_pair: tuple[int, str]) -> None:
             link.send(frame)
         wire = read_exactly(master, sum(len(f) for f in FRAMES))
         assert wire == b"".join(FRAMES)
-        os.write(master, dp.accepted_line(dp.decode(FRAMES[0])) + dp.rejected_line(dp.ErrorKind.BUSY))
+        os.write(master, dp.accepted_line(dp.decode(FRAMES[0]), ST, False)
+                 + dp.rejected_line(dp.ErrorKind.BUSY, ST, False))
         replies: list[dp.Reply] = []
         deadline = time.monotonic() + 5.0
         while len(replies) < 2 and time.monotonic() < deadline:

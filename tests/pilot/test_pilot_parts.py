@@ -23,7 +23,7 @@ from pilot.sim.model import DroneModel, Outputs, StickCentres
 from pilot.sim.room import SCENARIOS, Room, make_scenario
 from pilot.sources import CameraSource, ImageFolderSource, VideoFileSource
 
-PAN0, TILT0 = dp.SERVOS["pan"].default, dp.SERVOS["tilt"].default
+PAN0, TILT0 = dp.SERVOS[dp.ServoName.PAN].default, dp.SERVOS[dp.ServoName.TILT].default
 
 # -- config --------------------------------------------------------------------------------------------
 
@@ -76,7 +76,8 @@ def test_calibration_of_red_gives_two_ranges_that_find_the_target(tmp_path: Path
     assert len(ranges) == 2
     assert ranges[0][0][0] == 0 and ranges[1][1][0] == 179
     det = HsvBlobDetector(HsvConfig(ranges=ranges))
-    moved = synth.degrade(synth.red_disc(bg, 80, 60, 20), 1.0, 0.0, 0)
+    moved = bg.copy()
+    cv2.circle(moved, (80, 60), 20, (40, 20, 200), -1)  # the calibrated red, elsewhere
     d = det.detect(moved)
     assert d.found and abs(d.cx - 80) <= 1.5 and abs(d.cy - 60) <= 1.5
     assert not det.detect(synth.background(320, 240)).found
@@ -98,6 +99,30 @@ def test_calibration_of_blue_gives_one_range_and_is_saved(tmp_path: Path) -> Non
     assert reloaded.hsv.ranges == cfg.hsv.ranges
     assert reloaded.controller.fire_ms == 700  # the rest of the file is kept
     assert HsvBlobDetector(reloaded.hsv).detect(img).found
+    assert (tmp_path / "pilot.calibration.png").exists()  # the mask preview, next to the config
+
+
+def test_calibration_takes_the_hue_mode_not_the_background_in_the_roi(tmp_path: Path) -> None:
+    """A ROI half filled by an orange background still gives a range around the target's red."""
+    img = synth.background(320, 240)
+    cv2.rectangle(img, (160, 0), (320, 240), (0, 140, 255), -1)  # orange wall on the right half
+    cv2.circle(img, (150, 120), 28, (30, 30, 210), -1)
+    (lo, hi), *rest = hsv_ranges_from_sample(img, roi=(120, 90, 70, 60))
+    hues = {h for r in [(lo, hi), *rest] for h in range(r[0][0], r[1][0] + 1)}
+    assert 0 in hues and not hues & set(range(10, 20))  # red in, orange (hue ~16) out
+
+
+def test_calibration_refuses_ranges_that_match_the_room(tmp_path: Path) -> None:
+    img = synth.background(320, 240)
+    cv2.rectangle(img, (0, 0), (320, 120), (30, 30, 200), -1)  # a red wall behind a red target
+    cv2.circle(img, (160, 150), 30, (30, 30, 210), -1)
+    image_path = tmp_path / "red_wall.png"
+    cv2.imwrite(str(image_path), img)
+    cfg_path = tmp_path / "pilot.yaml"
+    with pytest.raises(ConfigError, match=r"calibration refused: .* of the picture outside the roi"):
+        calibrate_to_config(image_path, cfg_path, roi=(140, 130, 40, 40))
+    assert not cfg_path.exists()  # nothing saved
+    assert (tmp_path / "pilot.calibration.png").exists()  # but the preview shows why
 
 
 def test_calibration_roi_outside_the_image() -> None:
@@ -180,8 +205,8 @@ def neutral(**kw: int | bool) -> Outputs:
         "throttle": ch["throttle"].median,
         "yaw": ch["yaw"].median,
         "mode": 0,
-        "pan": dp.SERVOS["pan"].default,
-        "tilt": dp.SERVOS["tilt"].default,
+        "pan": dp.SERVOS[dp.ServoName.PAN].default,
+        "tilt": dp.SERVOS[dp.ServoName.TILT].default,
         "laser": False,
         "armed": True,  # the firmware's flag: the model does not read it
     }

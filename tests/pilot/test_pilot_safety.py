@@ -182,9 +182,9 @@ def test_fault_in_any_stage_ends_laser_off_neutral_disarmed(stage: str, virtual_
     assert out.laser is False and out.armed is False
     assert f.world.fw_state == "disarmed"
     assert (out.roll, out.pitch, out.yaw) == (
-        dp.CHANNELS["roll"].median,
-        dp.CHANNELS["pitch"].median,
-        dp.CHANNELS["yaw"].median,
+        dp.CHANNELS[dp.ChannelName.ROLL].median,
+        dp.CHANNELS[dp.ChannelName.PITCH].median,
+        dp.CHANNELS[dp.ChannelName.YAW].median,
     )
     assert f.world.model.state.z == 0.0 and f.world.model.state.crashes == 0
     assert not f.world.model.state.armed  # the flight controller saw the disarm sticks
@@ -205,12 +205,14 @@ def test_lost_camera_lands_and_disarms(virtual_drone: Path) -> None:
 
 
 def make_video(path: Path, frames: int = 600) -> None:
-    """A red disc in the middle of the picture: the pilot locks on and fires."""
+    """A red disc in the middle of the picture: the pilot locks on and fires. Sensor noise in every frame
+    (identical frames are a frozen camera, which the pilot refuses)."""
     writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"MJPG"), 20.0, (320, 240))
     img = np.full((240, 320, 3), (150, 160, 170), np.uint8)
     cv2.circle(img, (160, 120), 40, (30, 30, 210), -1)
+    rng = np.random.default_rng(1)
     for _ in range(frames):
-        writer.write(img)
+        writer.write(cv2.add(img, rng.integers(0, 6, img.shape, np.uint8)))
     writer.release()
 
 

@@ -7,7 +7,9 @@
 //                            stdout: "frame <hex>" for every frame the StreamParser emits (re-encoded), then
 //                            "pending <n>" and one "count <error name> <n>" per parser error kind
 //   protocol_driver replies  stdout: the ready line, the accepted line of every command (at its minimum), the
-//                            rejected line of every error kind, and the failsafe line, each as hex
+//                            rejected line of every error kind, and the failsafe line of every state, each as
+//                            hex; the status cycles through the states in spec order (the command's, error's
+//                            or state's index modulo STATE_COUNT), the laser is on at odd indexes
 //
 // Every result is also checked here: a decoded command re-encodes to the same bytes, lies in its command's
 // range and matches its CommandInfo; the parser never holds a full frame. A failed check exits 3.
@@ -46,9 +48,9 @@ static void check_command(const Command& cmd, const uint8_t* expected, const cha
   const CommandInfo info = command_info(cmd.id);
   if (info.category != cmd.category || info.direction != cmd.direction) fail("command_info disagrees", line);
   if (cmd.value < info.min || cmd.value > info.max) fail("value outside the command's range", line);
-  uint8_t again[FRAME_LENGTH];
+  uint8_t again[WIRE_LENGTH];
   if (encode(cmd, again) != Error::None) fail("a decoded command does not encode", line);
-  if (expected != nullptr && memcmp(again, expected, FRAME_LENGTH) != 0) fail("re-encoding differs", line);
+  if (expected != nullptr && memcmp(again, expected, WIRE_LENGTH) != 0) fail("re-encoding differs", line);
   Command back{};
   if (decode(again, back) != Error::None || back.id != cmd.id || back.value != cmd.value) {
     fail("re-encoded frame does not decode to the same command", line);
@@ -90,13 +92,13 @@ static int run_stream() {
       if (parser.feed(bytes[i], static_cast<uint32_t>(now))) {
         if (parser.pending() != 0) fail("bytes pending right after a frame", line);
         check_command(parser.command(), nullptr, line);
-        uint8_t out[FRAME_LENGTH];
+        uint8_t out[WIRE_LENGTH];
         encode(parser.command(), out);
         printf("frame ");
-        for (uint8_t k = 0; k < FRAME_LENGTH; ++k) printf("%02x", out[k]);
+        for (uint8_t k = 0; k < WIRE_LENGTH; ++k) printf("%02x", out[k]);
         printf("\n");
       }
-      if (parser.pending() >= FRAME_LENGTH) fail("pending() holds a full frame", line);
+      if (parser.pending() >= WIRE_LENGTH) fail("pending() holds a full frame", line);
     }
   }
   printf("pending %u\n", static_cast<unsigned>(parser.pending()));
@@ -115,13 +117,15 @@ static void print_line(const char* line, uint8_t n) {
 static int run_replies() {
   char line[REPLY_MAX_LENGTH + 8];
   print_line(line, write_ready(line));
-  for (uint8_t i = 0; i < COMMAND_COUNT; ++i) {
+  for (CommandIndex i = 0; i < COMMAND_COUNT; ++i) {
     const CommandInfo info = command_info(static_cast<CommandId>(i));
     const Command cmd{static_cast<CommandId>(i), info.category, info.direction, info.min};
-    print_line(line, write_accepted(cmd, line));
+    print_line(line, write_accepted(cmd, static_cast<State>(i % STATE_COUNT), i % 2 == 1, line));
   }
-  for (uint8_t e = 1; e <= ERROR_COUNT; ++e) print_line(line, write_rejected(static_cast<Error>(e), line));
-  print_line(line, write_failsafe(line));
+  for (uint8_t e = 1; e <= ERROR_COUNT; ++e) {
+    print_line(line, write_rejected(static_cast<Error>(e), static_cast<State>(e % STATE_COUNT), e % 2 == 1, line));
+  }
+  for (uint8_t s = 0; s < STATE_COUNT; ++s) print_line(line, write_failsafe(static_cast<State>(s), s % 2 == 1, line));
   return 0;
 }
 

@@ -1,0 +1,98 @@
+"""Scoring detectors on the composed real-photo views: recall, false detections, position error.
+
+A detection counts at or above a confidence threshold (the pilot's ``controller.acquire_confidence``);
+on a target view it is correct within max(3 px, 30 % of the target's size) of the truth, and a
+detection anywhere else is a miss. Records keep every confidence, so one pass serves a whole threshold
+sweep.
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+
+import numpy as np
+import vision_imagery as vi
+from cv2.typing import MatLike
+
+from pilot.detection import Detection
+
+Detect = Callable[[MatLike], Detection]
+
+
+@dataclass(frozen=True)
+class Record:
+    kind: str  # target, empty, distractor
+    group: str  # the condition (targets, empty views) or the distractor kind
+    size: float
+    found: bool
+    confidence: float
+    error: float  # pixels from the truth (targets), inf when nothing was found
+
+
+def samples(split: tuple[str, ...], seed: int, per_condition: int, empty: int, per_distractor: int,
+            target: str, sizes: tuple[float, float], conditions: Iterable[str]) -> list[vi.Sample]:
+    rng = np.random.default_rng(seed)
+    out = [vi.target_sample(rng, split, c, target, sizes, edge=c == "edge")
+           for c in conditions for _ in range(per_condition)]
+    out += [vi.empty_sample(rng, split) for _ in range(empty)]
+    out += [vi.distractor_sample(rng, split, k) for k in vi.DISTRACTOR_KINDS for _ in range(per_distractor)]
+    return out
+
+
+def run(detect: Detect, views: list[vi.Sample]) -> list[Record]:
+    records = []
+    for s in views:
+        d = detect(s.image)
+        err = math.hypot(d.cx - s.cx, d.cy - s.cy) if d.found and s.kind == "target" else math.inf
+        records.append(Record(s.kind, s.condition, s.size, d.found, d.confidence if d.found else 0.0, err))
+    return records
+
+
+def correct(r: Record, threshold: float) -> bool:
+    return r.found and r.confidence >= threshold and r.error <= max(3.0, 0.3 * r.size)
+
+
+def detected(r: Record, threshold: float) -> bool:
+    return r.found and r.confidence >= threshold
+
+
+@dataclass(frozen=True)
+class Row:
+    group: str
+    n: int
+    rate: float  # recall (targets) or share of views with a detection (empty, distractor)
+    median_error: float = math.nan
+    p95_error: float = math.nan
+
+
+def target_rows(records: list[Record], threshold: float, min_size: float) -> list[Row]:
+    rows = []
+    groups = dict.fromkeys(r.group for r in records if r.kind == "target")
+    for g in groups:
+        rs = [r for r in records if r.kind == "target" and r.group == g and r.size >= min_size]
+        ok = [r for r in rs if correct(r, threshold)]
+        errs = sorted(r.error for r in ok)
+        med = statistics.median(errs) if errs else math.nan
+        p95 = errs[min(len(errs) - 1, int(0.95 * len(errs)))] if errs else math.nan
+        rows.append(Row(g, len(rs), len(ok) / len(rs) if rs else math.nan, med, p95))
+    return rows
+
+
+def false_rows(records: list[Record], threshold: float, kind: str) -> list[Row]:
+    rs = [r for r in records if r.kind == kind]
+    groups = dict.fromkeys(r.group for r in rs)
+    rows = [Row(g, n := sum(1 for r in rs if r.group == g),
+                sum(1 for r in rs if r.group == g and detected(r, threshold)) / n) for g in groups]
+    return [*rows, Row("all", len(rs), sum(1 for r in rs if detected(r, threshold)) / len(rs) if rs else math.nan)]
+
+
+def overall(records: list[Record], threshold: float, min_size: float) -> tuple[float, float, float, float]:
+    """Worst recall over the conditions but occlusion, recall under occlusion, empty rate, distractor rate."""
+    rows = {r.group: r.rate for r in target_rows(records, threshold, min_size)}
+    worst = min((v for k, v in rows.items() if k != "occlusion"), default=math.nan)
+    empty = false_rows(records, threshold, "empty")[-1].rate
+    distr = false_rows(records, threshold, "distractor")[-1].rate
+    return worst, rows.get("occlusion", math.nan), empty, distr

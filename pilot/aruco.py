@@ -1,0 +1,89 @@
+"""The ArUco marker detector, with parameters for the frames a drone sees: blur, the frame's edge, dim light.
+
+* ``minDistanceToBorder`` 0: a marker touching the frame's edge is still read (OpenCV's default, 3 px,
+  drops it just when the drone turns towards it).
+* Adaptive-threshold windows from 3 to 53 px (default up to 23): wide windows keep a blurred marker's
+  cells apart.
+* Sub-pixel corner refinement: the centre and the side (hence the range) to a fraction of a pixel.
+* A second look at half resolution when the full frame has no marker: motion blur shrinks with the image.
+Every marker of the configured id is a candidate; its size must imply a plausible range.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+from cv2.typing import MatLike
+
+from .config import ArucoConfig, VisionConfig
+from .detection import Candidate, Detection, frame_size, range_of
+from .errors import ConfigError
+
+
+def aruco_dictionary(name: str) -> cv2.aruco.Dictionary:
+    code = getattr(cv2.aruco, name, None)
+    if not name.startswith("DICT_") or not isinstance(code, int):
+        raise ConfigError(f"aruco.dictionary: unknown ArUco dictionary {name!r} (e.g. DICT_4X4_50)")
+    return cv2.aruco.getPredefinedDictionary(code)
+
+
+def detector_parameters(adaptive_thresh_constant: float) -> cv2.aruco.DetectorParameters:
+    params = cv2.aruco.DetectorParameters()
+    params.adaptiveThreshConstant = adaptive_thresh_constant
+    params.adaptiveThreshWinSizeMin = 3
+    params.adaptiveThreshWinSizeMax = 53
+    params.adaptiveThreshWinSizeStep = 10
+    params.minDistanceToBorder = 0
+    params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
+    params.cornerRefinementWinSize = 3
+    return params
+
+
+class ArucoMarkerDetector:
+    name = "aruco"
+
+    def __init__(
+        self, config: ArucoConfig | None = None, vision: VisionConfig | None = None, fov_deg: float = 60.0
+    ) -> None:
+        cfg = config or ArucoConfig()
+        self.cfg = cfg
+        self.marker_id = cfg.marker_id
+        self.vision = vision or VisionConfig()
+        self.fov_deg = fov_deg
+        self._detector = cv2.aruco.ArucoDetector(
+            aruco_dictionary(cfg.dictionary), detector_parameters(cfg.adaptive_thresh_constant)
+        )
+
+    def _markers(self, grey: MatLike, scale: float, width: int) -> list[Candidate]:
+        corners, ids, _ = self._detector.detectMarkers(grey)
+        if ids is None or len(corners) == 0:
+            return []
+        found = []
+        for quad, marker in zip(corners, np.asarray(ids).reshape(-1), strict=True):
+            if self.marker_id >= 0 and int(marker) != self.marker_id:
+                continue
+            pts = np.asarray(quad, dtype=np.float64).reshape(4, 2) * scale
+            side = float(np.linalg.norm(pts - np.roll(pts, 1, axis=0), axis=1).mean())
+            distance = range_of(side, self.cfg.marker_size_m, width, self.fov_deg)
+            if self.vision.range_min_m <= distance <= self.vision.range_max_m:
+                centre = pts.mean(axis=0)
+                found.append(Candidate(float(centre[0]), float(centre[1]), side, 1.0))
+        return sorted(found, key=lambda c: c.size, reverse=True)
+
+    def candidates(self, image: MatLike) -> list[Candidate]:
+        grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
+        width = frame_size(image)[0]
+        found = self._markers(grey, 1.0, width)
+        if not found:
+            found = self._markers(cv2.pyrDown(grey), 2.0, width)  # pyrDown's pixel j is centred on pixel 2j
+        return found
+
+    def detect(self, image: MatLike) -> Detection:
+        """This frame alone, the largest marker of the id (no tracking, no frame checks)."""
+        w, h = frame_size(image)
+        cands = self.candidates(image)
+        if not cands:
+            return Detection(False, width=w, height=h)
+        best = cands[0]
+        distance = range_of(best.size, self.cfg.marker_size_m, w, self.fov_deg)
+        return Detection(True, best.cx, best.cy, best.size, best.score, w, h, range_m=distance)

@@ -1,0 +1,88 @@
+"""What the detectors say: a typed frame status, scored candidates, and one Detection per frame."""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass
+from typing import Protocol
+
+from cv2.typing import MatLike
+
+
+class FrameStatus(enum.Enum):
+    """Why a frame was (not) looked at. Anything but OK means: no detection, hold or land."""
+
+    OK = "ok"
+    WRONG_TYPE = "wrong type"  # not an 8-bit image array
+    WRONG_SHAPE = "wrong shape"  # not 3 channels, too small, or not the size the camera started with
+    BLACK = "black"
+    SATURATED = "saturated"
+    FROZEN = "frozen"  # the same pixels frame after frame: the camera has stopped
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One possible target in one frame, scored 0..1 on that frame alone."""
+
+    cx: float
+    cy: float
+    size: float  # apparent diameter (a ball) or mean side (a marker), pixels
+    score: float
+
+
+@dataclass(frozen=True)
+class Detection:
+    found: bool
+    cx: float = 0.0  # centre, pixels
+    cy: float = 0.0
+    size: float = 0.0  # apparent size, pixels (the ball's diameter, a marker's mean side)
+    confidence: float = 0.0  # 0..1
+    width: int = 0  # frame size the numbers refer to
+    height: int = 0
+    range_m: float = 0.0  # estimated from the apparent size and the target's known size (0: unknown)
+    status: FrameStatus = FrameStatus.OK
+    predicted: bool = False  # bridged by the tracker through a missed frame, not measured in this one
+
+    @property
+    def error_x(self) -> float:
+        """Horizontal offset from the image centre, -1 (left edge) .. +1 (right edge)."""
+        return (self.cx - self.width / 2.0) / (self.width / 2.0) if self.width else 0.0
+
+    @property
+    def error_y(self) -> float:
+        """Vertical offset from the image centre, -1 (top) .. +1 (bottom)."""
+        return (self.cy - self.height / 2.0) / (self.height / 2.0) if self.height else 0.0
+
+    @property
+    def relative_size(self) -> float:
+        """Apparent size as a fraction of the frame width."""
+        return self.size / self.width if self.width else 0.0
+
+
+class Detector(Protocol):
+    name: str
+
+    def detect(self, image: MatLike) -> Detection: ...
+
+
+class CandidateSource(Protocol):
+    """A single-frame detector: every candidate in the frame, best first."""
+
+    name: str
+
+    def candidates(self, image: MatLike) -> list[Candidate]: ...
+
+
+def focal_px(width: int, horizontal_fov_deg: float) -> float:
+    return (width / 2.0) / math.tan(math.radians(horizontal_fov_deg) / 2.0)
+
+
+def range_of(size_px: float, object_m: float, width: int, horizontal_fov_deg: float) -> float:
+    """Pinhole range of an object of known size seen ``size_px`` wide."""
+    return object_m * focal_px(width, horizontal_fov_deg) / size_px if size_px > 0 else math.inf
+
+
+def frame_size(image: MatLike) -> tuple[int, int]:
+    h, w = image.shape[:2]
+    return int(w), int(h)

@@ -1,0 +1,129 @@
+"""The codec installs alone from its wheel; the project's distribution claims no generic top-level name."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import venv
+import zipfile
+from pathlib import Path
+
+import drone_protocol as dp
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+CODEC = ROOT / "generated" / "python"
+BIN = Path(sys.executable).parent
+
+
+def _run(*cmd: str | Path, cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess[str]:
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+    return subprocess.run([str(c) for c in cmd], cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+
+
+def _wheel(source: Path, out: Path) -> Path:
+    """`pip wheel` of a copy of `source` (so that the build cannot write into the repository)."""
+    copy = out / "src"
+    shutil.copytree(source, copy, ignore=shutil.ignore_patterns("__pycache__", ".venv", "build", "*.egg-info"))
+    proc = _run(sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", out / "dist", copy, cwd=out)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    # quiet: no setuptools warnings such as "Package 'generator.templates...' would be ignored"
+    assert "Warning" not in proc.stdout + proc.stderr, proc.stdout + proc.stderr
+    (wheel,) = (out / "dist").glob("*.whl")
+    return wheel
+
+
+@pytest.fixture(scope="module")
+def codec_wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return _wheel(CODEC, tmp_path_factory.mktemp("codec"))
+
+
+def _metadata(wheel: Path) -> str:
+    with zipfile.ZipFile(wheel) as zf:
+        name = next(n for n in zf.namelist() if n.endswith(".dist-info/METADATA"))
+        return zf.read(name).decode("utf-8")
+
+
+def test_the_codec_wheel_holds_the_package_alone(codec_wheel: Path) -> None:
+    with zipfile.ZipFile(codec_wheel) as zf:
+        names = zf.namelist()
+    tops = {n.split("/")[0] for n in names}
+    assert tops == {dp.PROTOCOL_NAME, f"{dp.PROTOCOL_NAME}-{dp.PROTOCOL_VERSION}.dist-info"}, tops
+    assert f"{dp.PROTOCOL_NAME}/py.typed" in names and f"{dp.PROTOCOL_NAME}/__init__.py" in names
+    meta = _metadata(codec_wheel)
+    assert re.search(rf"^Name: {dp.PROTOCOL_NAME.replace('_', '-')}$", meta, re.M)
+    assert re.search(rf"^Version: {dp.PROTOCOL_VERSION}$", meta, re.M)
+    assert re.search(r"^Requires-Python: >=3\.9$", meta, re.M)
+    assert "Requires-Dist" not in meta
+    assert dp.SPEC_FINGERPRINT in meta  # the README is the long description
+
+
+def test_the_codec_wheel_installs_and_imports_in_a_fresh_venv_with_nothing_else(
+    codec_wheel: Path, tmp_path: Path
+) -> None:
+    env_dir = tmp_path / "venv"
+    venv.EnvBuilder(with_pip=True).create(env_dir)
+    python = env_dir / "bin" / "python"
+    proc = _run(python, "-m", "pip", "install", "-q", "--no-index", codec_wheel, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    listed = _run(python, "-m", "pip", "list", "--format=json", cwd=tmp_path)
+    installed = {p["name"].lower() for p in json.loads(listed.stdout)}
+    assert installed - {"pip", "setuptools"} == {dp.PROTOCOL_NAME.replace("_", "-")}
+    # the README's example, run as written, from a folder that is not the repository
+    readme = (CODEC / "README.md").read_text(encoding="utf-8")
+    (example,) = re.findall(r"```python\n(.*?)```", readme, re.S)
+    check = (
+        f"{example}\nimport {dp.PROTOCOL_NAME}, sys\n"
+        f"assert {dp.PROTOCOL_NAME}.__file__.startswith(sys.prefix), {dp.PROTOCOL_NAME}.__file__\n"
+        f"assert {dp.PROTOCOL_NAME}.decode(frame) == command\n"
+        f"print({dp.PROTOCOL_NAME}.SPEC_FINGERPRINT)"
+    )
+    run = _run(python, "-I", "-c", check, cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.strip() == dp.SPEC_FINGERPRINT
+
+
+def test_the_project_wheel_installs_one_namespace_of_its_own(tmp_path: Path) -> None:
+    src = tmp_path / "project"
+    src.mkdir()
+    for name in ("pyproject.toml", "setup.py", "README.md", "LICENSE", "generator", "pilot"):
+        path = ROOT / name
+        if path.is_dir():
+            shutil.copytree(path, src / name, ignore=shutil.ignore_patterns("__pycache__"))
+        else:
+            shutil.copy(path, src / name)
+    wheel = _wheel(src, tmp_path)
+    with zipfile.ZipFile(wheel) as zf:
+        names = zf.namelist()
+    tops = {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")}
+    assert tops == {"drone_protocol_tools"}
+    assert "drone_protocol_tools/generator/cli.py" in names and "drone_protocol_tools/pilot/cli.py" in names
+    assert any(n.startswith("drone_protocol_tools/generator/templates/python/") for n in names)
+    assert re.search(rf"^Requires-Dist: {dp.PROTOCOL_NAME.replace('_', '-')}$", _metadata(wheel), re.M)
+
+
+def test_outside_the_repo_the_installed_names_are_the_namespaced_ones(tmp_path: Path) -> None:
+    code = (
+        "import importlib.util as u\n"
+        "import drone_protocol_tools.generator.cli, drone_protocol_tools.pilot.cli\n"
+        "print([n for n in ('generator', 'pilot') if u.find_spec(n) is not None])"
+    )
+    run = _run(sys.executable, "-c", code, cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.strip() == "[]"
+
+
+def test_the_console_scripts_outside_the_repo(tmp_path: Path) -> None:
+    gen = _run(BIN / "drone-protocol-gen", cwd=tmp_path)
+    assert gen.returncode == 2 and not (tmp_path / "generated").exists()
+    assert gen.stderr.count("\n") == 1 and "pass --spec FILE" in gen.stderr, gen.stderr
+    version = _run(BIN / "drone-protocol-gen", "--version", cwd=tmp_path)
+    assert version.returncode == 0 and "no spec" in version.stdout
+    with_spec = _run(BIN / "drone-protocol-gen", "--version", "--spec", ROOT / "spec" / "drone.yaml", cwd=tmp_path)
+    assert with_spec.returncode == 0 and dp.SPEC_FINGERPRINT in with_spec.stdout
+    pilot = _run(BIN / "pilot", "--version", cwd=tmp_path)
+    assert pilot.returncode == 0 and dp.SPEC_FINGERPRINT in pilot.stdout, pilot.stdout + pilot.stderr

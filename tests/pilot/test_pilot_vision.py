@@ -1,0 +1,125 @@
+"""The vision pipeline's guarantees: typed bad-frame results, the gate, and a small real-photo evaluation
+(tuning photos only; the full one with the held-out photos is ``make bench-vision``)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+import vision_eval as ve
+import vision_imagery as vi
+
+from pilot.aruco import ArucoMarkerDetector
+from pilot.config import ControllerConfig, PilotConfig
+from pilot.controller import Controller, State
+from pilot.detect import make_detector
+from pilot.detection import Detection, FrameStatus
+from pilot.errors import ConfigError
+from pilot.gating import Gate
+from pilot.hsv import HsvBlobDetector
+
+
+@pytest.mark.parametrize(
+    "image,status",
+    [
+        (np.zeros((240, 320, 3), np.uint8), FrameStatus.BLACK),
+        (np.full((240, 320, 3), 255, np.uint8), FrameStatus.SATURATED),
+        (np.zeros((240, 320), np.uint8) + 100, FrameStatus.WRONG_SHAPE),
+        (np.zeros((240, 320, 4), np.uint8) + 100, FrameStatus.WRONG_SHAPE),
+        (np.zeros((240, 320, 3), np.float32) + 100, FrameStatus.WRONG_TYPE),
+        ("not an image", FrameStatus.WRONG_TYPE),
+    ],
+)
+def test_bad_frames_are_named_and_never_found(image: object, status: FrameStatus) -> None:
+    det = make_detector(PilotConfig()).detect(image)  # type: ignore[arg-type]
+    assert det.status is status and not det.found
+
+
+def test_frozen_camera_and_size_change() -> None:
+    det = make_detector(PilotConfig())
+    rng = np.random.default_rng(0)
+    frame = vi.target_sample(rng, vi.TUNING, "clean", "ball", (40, 60)).image
+    results = [det.detect(frame).status for _ in range(6)]
+    assert results[:4] == [FrameStatus.OK] * 4 and results[4:] == [FrameStatus.FROZEN] * 2
+    assert det.detect(np.ascontiguousarray(frame[:200, :300])).status is FrameStatus.WRONG_SHAPE
+
+
+def state_of(c: Controller) -> State:
+    return c.state
+
+
+def _flying_controller(cfg: ControllerConfig) -> Controller:
+    c = Controller(cfg, clock=lambda: 0.0)
+    c.state = State.SEARCH
+    return c
+
+
+def test_gate_low_confidence_is_no_sighting_and_bad_frames_hold_then_land() -> None:
+    cfg = ControllerConfig()
+    c = _flying_controller(cfg)
+    weak = Detection(True, 160, 120, 40, cfg.acquire_confidence - 0.01, 320, 240, range_m=2.0)
+    c.update(weak)
+    assert state_of(c) is State.SEARCH and not c.gate.acquired()
+    strong = dataclasses.replace(weak, confidence=cfg.acquire_confidence)
+    c.update(strong)
+    assert state_of(c) is State.ACQUIRE
+    black = Detection(False, width=320, height=240, status=FrameStatus.BLACK)
+    for _ in range(cfg.blind_frames - 1):
+        assert c.update(black) is not None and state_of(c) is State.ACQUIRE  # hold (hold_altitude)
+    c.update(black)
+    assert state_of(c) is State.LAND
+
+
+def test_gate_confirms_only_measured_centred_near_frames_in_a_row() -> None:
+    cfg = ControllerConfig()
+    gate = Gate(cfg)
+    good = Detection(True, 160, 120, 60, 0.9, 320, 240, range_m=1.4)
+    for bad in (dataclasses.replace(good, predicted=True), dataclasses.replace(good, cx=200),
+                dataclasses.replace(good, range_m=cfg.fire_range_max_m + 1), dataclasses.replace(good, confidence=0.1)):
+        for _ in range(cfg.confirm_frames - 1):
+            gate.observe(good)
+        gate.observe(bad)
+        assert not gate.confirmed()
+    for _ in range(cfg.confirm_frames):
+        gate.observe(good)
+    assert gate.confirmed()
+
+
+@pytest.mark.parametrize(
+    "option,value", [("acquire_confidence", 1.5), ("confirm_frames", 0), ("fire_range_max_m", 99.0)]
+)
+def test_gate_options_out_of_range_are_refused_by_name(option: str, value: float) -> None:
+    with pytest.raises(ConfigError, match=f"controller.{option}"):
+        from pilot.config import from_dict
+
+        from_dict({"controller": {option: value}})
+
+
+@pytest.fixture(scope="module")
+def small_eval() -> tuple[list[ve.Record], list[ve.Record]]:
+    ball = ve.samples(vi.TUNING, 11, 12, 60, 8, "ball", (16.0, 120.0), vi.CONDITIONS)
+    markers = ve.samples(vi.TUNING, 12, 12, 0, 0, "marker", (24.0, 120.0), ("clean", "motion_blur"))
+    negatives = [s for s in ball if s.kind != "target"]
+    return ve.run(HsvBlobDetector().detect, ball), ve.run(ArucoMarkerDetector().detect, markers + negatives)
+
+
+def test_real_photos_aruco_never_lights_a_non_marker_and_reads_clean_markers(
+    small_eval: tuple[list[ve.Record], list[ve.Record]],
+) -> None:
+    _, aruco = small_eval
+    rows = {r.group: r.rate for r in ve.target_rows(aruco, 0.5, 0)}
+    assert rows["clean"] >= 0.9  # goal: >= 90 %
+    assert ve.false_rows(aruco, 0.5, "empty")[-1].rate == 0.0  # goal: 0 false positives
+    assert ve.false_rows(aruco, 0.5, "distractor")[-1].rate == 0.0
+
+
+def test_real_photos_hsv_floors(small_eval: tuple[list[ve.Record], list[ve.Record]]) -> None:
+    """Regression floors at the levels reached (bench/vision/RESULTS.md); the issue's goals (recall >= 90 %,
+    empty <= 1 %, distractors <= 2 %) are not all met yet, and this test does not pretend they are."""
+    hsv, _ = small_eval
+    threshold = ControllerConfig().acquire_confidence
+    rows = {r.group: r.rate for r in ve.target_rows(hsv, threshold, 16)}
+    assert sum(rows.values()) / len(rows) >= 0.6
+    assert ve.false_rows(hsv, threshold, "empty")[-1].rate <= 0.05
+    assert ve.false_rows(hsv, threshold, "distractor")[-1].rate <= 0.2

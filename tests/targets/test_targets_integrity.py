@@ -1,0 +1,100 @@
+"""The Rust and C targets generated from the spec in crc8 integrity mode: their own test suites pass (wire frames
+carry the check, a wrong check is bad_check, reply lines end in *XX), and their stream parsers agree."""
+
+from __future__ import annotations
+
+import functools
+import os
+import subprocess
+from pathlib import Path
+
+import targets_harness as t
+import test_targets_differential as d
+
+from generator.cli import main as generate
+from generator.model import check_text
+
+BUILD = t.ROOT / "build" / "targets" / "crc8"
+
+
+@functools.cache
+def crc8_tree() -> Path:
+    spec = BUILD / "drone.yaml"
+    spec.parent.mkdir(parents=True, exist_ok=True)
+    text = (t.ROOT / "spec" / "drone.yaml").read_text(encoding="utf-8")
+    assert text.count("  integrity: none") == 1, "the test's edit of the spec no longer applies"
+    spec.write_text(text.replace("  integrity: none", "  integrity: crc8"), encoding="utf-8")
+    assert generate(["--spec", str(spec), "--out", str(BUILD / "generated")]) == 0
+    return BUILD / "generated"
+
+
+def c_driver(tree: Path) -> Path:
+    out = BUILD / "stream_driver_c"
+    t.run(["gcc", *t.CFLAGS, f"-I{tree / 'c'}", str(t.DRIVERS / "stream_driver.c"),
+           str(tree / "c" / "drone_protocol.c"), "-o", str(out)])
+    return out
+
+
+def test_the_crc8_crate_passes_its_tests_and_clippy() -> None:
+    crate = crc8_tree() / "rust"
+    env = {"CARGO_TARGET_DIR": str(BUILD / "target")}
+    t.run(["cargo", "test", "--locked", "--offline", "--quiet"], cwd=crate, env=env)
+    t.run(["cargo", "clippy", "--locked", "--offline", "--all-targets", "--quiet", "--", "-D", "warnings"], cwd=crate,
+          env=env)
+    assert 'pub const INTEGRITY: &str = "crc8";' in (crate / "src" / "lib.rs").read_text()
+
+
+def test_the_crc8_c_codec_passes_its_tests() -> None:
+    tree = crc8_tree()
+    exe = BUILD / "test_c_codec"
+    t.run(["gcc", *t.CFLAGS, "-fsanitize=address,undefined", f"-I{tree / 'c'}",
+           str(Path(t.__file__).parent / "c" / "test_c_codec.c"), str(tree / "c" / "drone_protocol.c"), "-o", str(exe)])
+    assert "agree" in t.run([str(exe), str(tree / "vectors.json")])
+
+
+def crc8_stream() -> str:
+    """The shared stream, with a check after each 6-byte piece of every burst of a multiple of 6 bytes (most of
+    them valid commands); one check in ten is wrong."""
+    lines = []
+    for i, line in enumerate(d.stream_lines(77, 40_000).splitlines()):
+        now, _, data = line.partition(" ")
+        raw = bytes.fromhex(data)
+        if raw and len(raw) % 6 == 0:
+            pieces = [raw[k:k + 6] for k in range(0, len(raw), 6)]
+            raw = b"".join(p + (check_text(p).encode() if i % 10 else b"00") for p in pieces)
+        lines.append(f"{now} {raw.hex()}")
+    return "\n".join(lines) + "\n"
+
+
+@functools.cache
+def crc8_outputs(language: str) -> list[str]:
+    tree = crc8_tree()
+    if language == "python":
+        env = {**os.environ, "PYTHONPATH": str(tree / "python")}
+        proc = subprocess.run(t.python_driver(), input=crc8_stream(), capture_output=True, text=True, timeout=120,
+                              check=True, env=env)
+        return proc.stdout.splitlines()
+    if language == "c":
+        return _run(c_driver(tree), crc8_stream())
+    t.run(["cargo", "build", "--release", "--locked", "--offline", "--quiet"], cwd=tree / "rust",
+          env={"CARGO_TARGET_DIR": str(BUILD / "target")})
+    rlib = BUILD / "target" / "release" / "libdrone_protocol.rlib"
+    rust = BUILD / "stream_driver_rs"
+    t.run(["rustc", "--edition", "2021", "-O", "--extern", f"drone_protocol={rlib}", "-L", str(rlib.parent / "deps"),
+           str(t.DRIVERS / "stream_driver.rs"), "-o", str(rust)])
+    return _run(rust, crc8_stream())
+
+
+def test_the_crc8_rust_and_c_stream_parsers_agree_on_checked_frames_and_garbage() -> None:
+    assert crc8_outputs("rust") == crc8_outputs("c")
+    errors = d.errors_of(crc8_outputs("c")[-1])
+    assert errors["bad_check"] > 100 and errors["out_of_range"] > 100 and len(crc8_outputs("c")) > 1000, errors
+
+
+def test_the_crc8_python_stream_decoder_agrees_with_rust_and_c() -> None:
+    assert crc8_outputs("python") == crc8_outputs("c")
+
+
+def _run(exe: Path, stdin: str) -> list[str]:
+    proc = subprocess.run([str(exe)], input=stdin, capture_output=True, text=True, timeout=120, check=True)
+    return proc.stdout.splitlines()
