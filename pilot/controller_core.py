@@ -268,6 +268,11 @@ class ControllerCore:
                 return None
             self._land_sent = True
             return self._emit(dp.land())
+        owed = self.drone.disarm_owed_since_ms
+        if owed is not None and state is dp.DroneState.DISARMED:
+            # the board's throttle is at its minimum: after the landing routine's time the drone is down, and
+            # the flight controller (which disarms only on the ground) sees the disarm sticks too
+            return self._emit(dp.disarm()) if self._now() - owed >= dp.LANDING_MS else None
         if self.drone.safe:
             self._go(State.DONE, f"drone confirmed {self.drone.describe()}")
             return None

@@ -20,13 +20,21 @@ class DroneView:
     replies: int = 0  # replies that carried a status
     last_ms: int | None = None  # when the latest status arrived (the controller's clock)
     refused_airborne: bool = False  # the drone refused a disarm as airborne: land instead
+    # armed, then disarmed without a disarm sequence in between (a rebooted board): the flight controller may
+    # still be armed, so a disarm (its stick sequence, harmless when disarmed) is still owed, once it is down
+    disarm_owed_since_ms: int | None = None
 
     def update(self, reply: dp.Reply, now_ms: int) -> None:
         if reply.kind is dp.ReplyKind.REJECTED and reply.error is dp.ErrorKind.AIRBORNE:
             self.refused_airborne = True
         if reply.state is None or reply.laser is None:
             return
+        was = self.state
         self.state, self.laser = reply.state, reply.laser
+        if self.state is dp.DroneState.DISARMING:
+            self.disarm_owed_since_ms = None
+        elif self.state is dp.DroneState.DISARMED and was in dp.ARMED_STATES and was is not dp.DroneState.DISARMING:
+            self.disarm_owed_since_ms = now_ms
         self.replies += 1
         self.last_ms = now_ms
         if self.state is not dp.DroneState.ARMED:

@@ -494,3 +494,20 @@ def test_config_changes_take_effect() -> None:
     for _ in range(4):
         rig.tick(seen(size=0.3))
     assert st(c) is State.LAND
+
+
+def test_a_board_that_reports_disarmed_without_disarming_still_gets_the_disarm_sticks() -> None:
+    """A rebooted board says "disarmed" while the flight controller may still be armed: once it is down
+    (the landing routine's time), the disarm sequence goes out anyway."""
+    c, rig = to_state(State.TRACK)
+    c.on_reply(refusal(dp.ErrorKind.NOT_ARMED, dp.DroneState.DISARMED))  # straight from moving to disarmed
+    assert st(c) is State.LAND
+    waited = 0
+    while (out := c.update(None)) is None or name(out) == "servo_reset":
+        rig.clock.advance_ms(50)
+        waited += 50
+        assert waited <= dp.LANDING_MS + 100
+    assert name(out) == "disarm" and waited >= dp.LANDING_MS - 50
+    c.on_reply(refusal(dp.ErrorKind.BUSY, dp.DroneState.DISARMING))
+    c.on_reply(refusal(dp.ErrorKind.NOT_ARMED, dp.DroneState.DISARMED))
+    assert c.update(None) is None and st(c) is State.DONE and c.drone.safe
