@@ -231,13 +231,18 @@ class ControllerCore:
                 why = f"drone confirmed armed ({state.name.lower()})" if state else "armed (unconfirmed)"
                 self._go(State.TAKEOFF, why)
                 return self._on_takeoff(det)
-            return None
+            return self._status_poll()
         if self._elapsed() >= 2 * dp.ARMING_HOLD_MS + dp.FAILSAFE_TIMEOUT_MS + self.cfg.arm_margin_ms:
             self._go(State.LAND, f"drone never confirmed armed ({self.drone.describe()})")
             return self._on_land(det)
         if state in (dp.DroneState.DISARMED, dp.DroneState.FAILSAFE):
             return self._emit(dp.arm())  # the arm frame (or its reply) was lost: again
-        return None
+        return self._status_poll()
+
+    def _status_poll(self) -> bytes | None:
+        """Waiting for the drone to confirm a change: a harmless frame every tick, since only a reply tells
+        (refused as busy during a sequence); nothing when no drone answers (a dry run)."""
+        return None if self.drone.state is None else self._emit(dp.hold_altitude())
 
     def _on_takeoff(self, det: Detection | None) -> bytes | None:
         if self._elapsed() >= self.cfg.takeoff_ms:
@@ -272,7 +277,7 @@ class ControllerCore:
         if owed is not None and state is dp.DroneState.DISARMED:
             # the board's throttle is at its minimum: after the landing routine's time the drone is down, and
             # the flight controller (which disarms only on the ground) sees the disarm sticks too
-            return self._emit(dp.disarm()) if self._now() - owed >= dp.LANDING_MS else None
+            return self._emit(dp.disarm()) if self._now() - owed >= dp.LANDING_MS else self._status_poll()
         if self.drone.safe:
             self._go(State.DONE, f"drone confirmed {self.drone.describe()}")
             return None
@@ -280,4 +285,4 @@ class ControllerCore:
             return self._emit(dp.disarm())  # armed on the ground: the plain disarm is shorter
         if state in dp.ARMED_STATES and state not in (dp.DroneState.LANDING, dp.DroneState.DISARMING):
             return self._emit(dp.land())
-        return None  # landing, disarming, arming, self-test, or laser still on: keep-alives until it ends
+        return self._status_poll()  # landing, disarming, arming, self-test: until it ends

@@ -127,7 +127,7 @@ def test_arm_waits_for_the_drone_to_confirm_it_then_takes_off() -> None:
         out = rig.tick(MISS)
         ticks += 1
         if st(c) is State.ARM:
-            assert out is None, "the arm frame arrived: nothing more until the drone confirms"
+            assert name(out) == "hold_altitude", "the arm frame arrived: status polls until the drone confirms"
             assert c.drone.state is dp.DroneState.ARMING or c.drone.state in dp.ARMED_STATES
     assert st(c) is State.TAKEOFF and name(out) == "move_up"
     assert out is not None and dp.decode(out).value > dp.CHANNELS[dp.ChannelName.THROTTLE].median
@@ -306,8 +306,8 @@ def test_fire_lights_by_confirmation_then_lands_through_the_firmware_routine() -
     assert name(out) == "laser_off" and st(c) is State.LAND and c.fired
     assert abs(c.lit_ms - CFG.fire_ms) <= 50
     frames = land_to_done(rig)
-    assert frames[:2] == ["servo_reset", "land"]  # the firmware's landing routine, then only keep-alives
-    assert "disarm" not in frames and set(frames[2:]) <= {"land"}
+    assert frames[:2] == ["servo_reset", "land"]  # the firmware's landing routine, then only status polls
+    assert "disarm" not in frames and set(frames[2:]) <= {"land", "hold_altitude"}
     assert rig.drone.state is dp.DroneState.DISARMED and not rig.drone.laser
     assert c.drone.safe and "confirmed disarmed" in c.transitions[-1].reason
     assert "laser_toggle" not in [name(f) for f in rig.sent]
@@ -417,7 +417,8 @@ def test_abort_while_firing_lands_and_waits_for_the_drone() -> None:
     c.abort("test")
     assert st(c) is State.LAND and not c.want_laser
     frames = land_to_done(rig)
-    assert [f for f in frames if f != "servo_reset"] == ["laser_off", "land"]  # servos home only if moved
+    ordered = [f for f in frames if f not in ("servo_reset", "hold_altitude")]  # servos home only if moved
+    assert ordered == ["laser_off", "land"]
     assert rig.drone.state is dp.DroneState.DISARMED and c.drone.safe
     # the firmware's landing routine and disarm sequence ran, and nothing after the drone confirmed
     assert rig.drone.log[-1][1] is dp.DroneState.DISARMED
@@ -430,7 +431,7 @@ def test_abort_on_the_ground_disarms_plainly() -> None:
     c.abort("test")
     assert name(c.update(None)) == "disarm"
     c.on_reply(refusal(dp.ErrorKind.BUSY, dp.DroneState.DISARMING))
-    assert c.update(None) is None  # keep-alives while it disarms
+    assert name(c.update(None)) == "hold_altitude"  # status polls while it disarms
     c.on_reply(refusal(dp.ErrorKind.NOT_ARMED, dp.DroneState.DISARMED))
     assert c.update(None) is None and st(c) is State.DONE and c.drone.safe
 
@@ -503,7 +504,7 @@ def test_a_board_that_reports_disarmed_without_disarming_still_gets_the_disarm_s
     c.on_reply(refusal(dp.ErrorKind.NOT_ARMED, dp.DroneState.DISARMED))  # straight from moving to disarmed
     assert st(c) is State.LAND
     waited = 0
-    while (out := c.update(None)) is None or name(out) == "servo_reset":
+    while name(out := c.update(None)) in ("servo_reset", "hold_altitude"):
         rig.clock.advance_ms(50)
         waited += 50
         assert waited <= dp.LANDING_MS + 100
