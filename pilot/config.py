@@ -20,10 +20,11 @@ from .errors import ConfigError
 HsvTriple = tuple[int, int, int]
 HsvRange = tuple[HsvTriple, HsvTriple]
 
-# Red wraps around hue 0 in OpenCV's 0..179 hue scale: it needs two ranges.
+# Red wraps around hue 0 in OpenCV's 0..179 hue scale: it needs two ranges. Hue within 6 units of red
+# (8 took in red-brown and orange-red surfaces that joined the ball: bench/vision, tuning photos).
 DEFAULT_RED: tuple[HsvRange, ...] = (
-    ((0, 120, 70), (8, 255, 255)),
-    ((172, 120, 70), (179, 255, 255)),
+    ((0, 120, 70), (6, 255, 255)),
+    ((174, 120, 70), (179, 255, 255)),
 )
 
 
