@@ -77,7 +77,8 @@ class ControllerConfig:
     arm_margin_ms: int = 300  # wait beyond the firmware's arming hold
     horizontal_fov_deg: float = 60.0  # camera field of view, for pan/tilt corrections and range estimates
     # the gate (pilot/gating.py); figures behind the defaults in bench/vision/RESULTS.md
-    acquire_confidence: float = 0.5  # a sighting counts only at or above this confidence
+    # the lowest pair that confirmed none of the tuning photos' empty and distractor sequences (bench/vision)
+    acquire_confidence: float = 0.6  # a sighting counts only at or above this confidence
     confirm_frames: int = 3  # measured, confident, centred, in-range frames in a row before the laser may fire
     fire_tolerance: float = 0.10  # normalised error within which a frame counts as centred for the gate
     fire_range_max_m: float = 3.0  # the laser fires only on a target estimated closer than this
