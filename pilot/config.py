@@ -21,10 +21,11 @@ from .errors import ConfigError
 HsvTriple = tuple[int, int, int]
 HsvRange = tuple[HsvTriple, HsvTriple]
 
-# Red wraps around hue 0 in OpenCV's 0..179 hue scale: it needs two ranges.
+# Red wraps around hue 0 in OpenCV's 0..179 hue scale: it needs two ranges. Hue within 6 units of red
+# (8 took in red-brown and orange-red surfaces that joined the ball: bench/vision, tuning photos).
 DEFAULT_RED: tuple[HsvRange, ...] = (
-    ((0, 120, 70), (8, 255, 255)),
-    ((172, 120, 70), (179, 255, 255)),
+    ((0, 120, 70), (6, 255, 255)),
+    ((174, 120, 70), (179, 255, 255)),
 )
 
 
@@ -79,7 +80,8 @@ class ControllerConfig:
     arm_margin_ms: int = 300  # wait after the drone confirms it armed
     horizontal_fov_deg: float = 60.0  # camera field of view, for pan/tilt corrections and range estimates
     # the gate (pilot/gating.py); figures behind the defaults in bench/vision/RESULTS.md
-    acquire_confidence: float = 0.5  # a sighting counts only at or above this confidence
+    # the lowest pair that confirmed none of the tuning photos' empty and distractor sequences (bench/vision)
+    acquire_confidence: float = 0.6  # a sighting counts only at or above this confidence
     confirm_frames: int = 3  # measured, confident, centred, in-range frames in a row before the laser may fire
     fire_tolerance: float = 0.10  # normalised error within which a frame counts as centred for the gate
     fire_range_max_m: float = 3.0  # the laser fires only on a target estimated closer than this
