@@ -64,8 +64,8 @@ class FlightResult:
             f"{self.scenario:10s} seed {self.seed:3d} {self.detector:5s} {verdict:15s} "
             f"lit {self.lit_on_target_ms:5d} ms "
             f"min dist {self.min_distance:4.2f} m walls {self.wall_hits} crashes {self.crashes} "
-            f"sim {self.sim_seconds:5.1f} s wall {self.wall_seconds:5.2f} s ({self.reason}); "
-            f"drone confirmed {self.confirmed}"
+            f"sim {self.sim_seconds:5.1f} s wall {self.wall_seconds:5.2f} s ({self.reason})"
+            + ("" if self.confirmed in self.reason else f"; drone confirmed {self.confirmed}")
         )
 
 
