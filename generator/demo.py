@@ -10,7 +10,7 @@ from pathlib import Path
 
 import drone_protocol as proto
 
-from generator.model import check_text
+from .model import check_text
 
 PRINTABLE = (string.digits + string.ascii_lowercase + string.ascii_uppercase).encode("ascii")
 
