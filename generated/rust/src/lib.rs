@@ -571,20 +571,14 @@ pub(crate) fn check_byte(frame: &Frame, pos: usize, id: &mut Option<CommandId>) 
                 None => Err(Error::BadDirection),
             }
         }
-        _ if pos < FRAME_LENGTH && frame[pos].is_ascii_digit() => Ok(()),
+        _ if frame[pos].is_ascii_digit() => Ok(()),
         _ => Err(Error::BadDigit),
     }
 }
 
-/// The value and range check of a frame whose bytes are all valid.
+/// The value of a complete wire frame whose bytes are all valid, checked against its command's range.
 #[inline]
 pub(crate) fn finish(frame: &Frame, id: CommandId) -> Result<Command, Error> {
-    finish_value(frame, id)
-}
-
-/// The value of a frame whose command bytes are all valid, checked against its command's range.
-#[inline]
-fn finish_value(frame: &Frame, id: CommandId) -> Result<Command, Error> {
     let mut value: u16 = 0;
     for &digit in &frame[2..FRAME_LENGTH] {
         value = value * 10 + u16::from(digit - b'0');

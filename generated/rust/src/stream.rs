@@ -6,8 +6,8 @@
 use crate::{check_byte, finish, Category, Command, CommandId, Error, Frame, FRAME_LENGTH, INTER_BYTE_TIMEOUT_MS, WIRE_LENGTH};
 
 
-/// While the buffer holds fewer bytes than this, a digit is a middle digit: it completes neither the frame nor
-/// its value (the fast path).
+/// While the buffer holds fewer bytes than this, a digit needs no check beyond being a digit: it does not
+/// complete the frame (the fast path).
 const DIGITS_END: usize = FRAME_LENGTH - 1;
 
 /// The error kinds a stream parser meets and counts.
