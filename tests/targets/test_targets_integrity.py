@@ -36,9 +36,10 @@ def c_driver(tree: Path) -> Path:
     return out
 
 
-def test_the_crc8_crate_passes_its_tests_and_clippy() -> None:
+def test_the_crc8_crate_passes_rustfmt_its_tests_and_clippy() -> None:
     crate = crc8_tree() / "rust"
     env = {"CARGO_TARGET_DIR": str(BUILD / "target")}
+    t.run(["cargo", "fmt", "--check"], cwd=crate)
     t.run(["cargo", "test", "--locked", "--offline", "--quiet"], cwd=crate, env=env)
     t.run(["cargo", "clippy", "--locked", "--offline", "--all-targets", "--quiet", "--", "-D", "warnings"], cwd=crate,
           env=env)
