@@ -3,6 +3,8 @@
 #   make bench-protocol   Python codec vs f-string/slice floors, C++ StreamParser throughput and instructions per
 #                         frame, parser flash/RAM on the ATmega328P, generator run time; writes
 #                         bench/protocol/RESULTS.md
+#                         (and the Python codec's stream decoder in callgrind instructions against its floor:
+#                         bench/protocol/PYTHON_INSTRUCTIONS.md)
 #   make bench-generator  generator time for the shipped and a 676-command spec, rejecting hostile specs;
 #                         writes bench/generator/RESULTS.md
 #   make bench-vision     the detectors on real photographs (scikit-image's) under 10 conditions, empty and
@@ -31,6 +33,7 @@ bench-vision: deps
 
 bench-protocol: deps
 	$(PY) bench/protocol/run.py --build $(BENCH_PROTOCOL_BUILD) $(BENCH_PROTOCOL_FLAGS)
+	$(PY) -m bench.protocol.python_instructions
 
 bench-generator: deps
 	$(PY) -m bench.generator.run

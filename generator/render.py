@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import json
 import os
 import tempfile
@@ -39,6 +41,34 @@ def _with_header(path: str, text: str, spec: Spec) -> str:
     return "".join(f"{style} {line}\n" for line in lines) + text
 
 
+class _TemplateCache(jinja2.FileSystemBytecodeCache):
+    """Compiled templates kept between runs (compiling them is most of a run's time). Keyed by each template's
+    source checksum, so an edited template is compiled again; a cache that cannot be read or written is skipped."""
+
+    def load_bytecode(self, bucket: jinja2.bccache.Bucket) -> None:
+        try:
+            super().load_bytecode(bucket)
+        except (OSError, ValueError, EOFError):
+            bucket.reset()
+
+    def dump_bytecode(self, bucket: jinja2.bccache.Bucket) -> None:
+        with contextlib.suppress(OSError):
+            super().dump_bytecode(bucket)
+
+
+@functools.cache
+def _template_cache() -> jinja2.BytecodeCache | None:
+    if os.environ.get("DRONE_PROTOCOL_GEN_NO_CACHE"):
+        return None
+    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+    folder = base / "drone-protocol-gen" / f"jinja2-{jinja2.__version__}"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return None
+    return _TemplateCache(str(folder))
+
+
 def _environment(target: Target) -> jinja2.Environment:
     env = jinja2.Environment(
         loader=jinja2.FileSystemLoader(TEMPLATES / target.name),
@@ -47,9 +77,11 @@ def _environment(target: Target) -> jinja2.Environment:
         lstrip_blocks=True,
         keep_trailing_newline=True,
         autoescape=False,
+        # Part of the compiled code: a target's options never change, and each target's templates have their
+        # own file names, which key the cache.
+        finalize=filters.html_text if target.escape == "html" else None,
+        bytecode_cache=_template_cache(),
     )
-    if target.escape == "html":
-        env.finalize = filters.html_text
     env.filters.update(filters.ALL)
     return env
 

@@ -15,7 +15,8 @@ from generator.targets import comment_style
 
 # What each format accepts as a comment: the header's first line must start with it.
 OPENERS = {".properties": "# ", ".txt": "# ", ".parm": "# ", ".py": "# ", ".typed": "# ", ".h": "// ",
-           ".ino": "// ", ".md": "<!--\n", ".c": "// ", ".rs": "// ", ".toml": "# ", ".lock": "# "}
+           ".ino": "// ", ".md": "<!--\n", ".c": "// ", ".rs": "// ", ".toml": "# ", ".lock": "# ", ".ts": "// ",
+           ".mjs": "// ", ".html": "<!--"}
 
 
 def test_every_generated_file_opens_with_its_own_formats_comment() -> None:
@@ -43,7 +44,7 @@ def test_library_properties_has_only_hash_comments_and_key_value_lines() -> None
 
 def test_keywords_are_tab_separated_and_name_what_the_header_defines() -> None:
     library = h.GENERATED / "arduino" / "DroneProtocol"
-    header = (library / "src" / "DroneProtocol.h").read_text(encoding="utf-8")
+    header = h.header_text(library / "src")
     kinds = set()
     for line in (library / "keywords.txt").read_text(encoding="utf-8").splitlines():
         if not line or line.startswith("#"):

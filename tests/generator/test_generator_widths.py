@@ -67,7 +67,7 @@ def python_value(p: ModuleType, name: str, spec: Spec) -> int | None:
 def check_generated(spec_path: Path, out: Path, p: ModuleType) -> None:
     spec = load_spec(spec_path)
     include = out / "arduino" / pascal(spec.name) / "src"
-    header = (include / f"{pascal(spec.name)}.h").read_text()
+    header = h.header_text(include)
     # the header declares each table constant with the table's type
     for name, (ctype, _, _) in SCALARS.items():
         found = re.search(rf"constexpr (\w+) {name} =", header)

@@ -110,6 +110,9 @@ from .tables import (
     TurnDirection,
 )
 
+#: The package's version (pyproject.toml's), from the spec's protocol.version.
+__version__ = "1.0.0"
+
 __all__ = [
     "SPEC_FINGERPRINT", "SPEC_SHA256", "PROTOCOL_NAME", "PROTOCOL_VERSION", "FRAME_LENGTH", "VALUE_WIDTH",
     "INTEGRITY", "CHECK_LENGTH", "WIRE_LENGTH", "BAUD", "DATA_BITS", "PARITY", "STOP_BITS", "READY_TIMEOUT_MS",

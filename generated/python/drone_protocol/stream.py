@@ -21,7 +21,10 @@ _FRAME_SHAPE = re.compile(
     b"[" + b"".join(re.escape(bytes([c])) for c in BY_BYTES) + b"]"
     + b"[" + b"".join(re.escape(bytes([d])) for c in BY_BYTES.values() for d in sorted(c)) + b"]"
     + b"[0-9]" * (FRAME_LENGTH - 2))
-_LAST_DIGIT = FRAME_LENGTH - 1
+# Pending lengths at which a byte is a value digit that completes nothing, and the one at which a byte
+# completes the wire frame.
+_DIGITS_END = FRAME_LENGTH if WIRE_LENGTH > FRAME_LENGTH else FRAME_LENGTH - 1
+_LAST = WIRE_LENGTH - 1
 
 
 class StreamDecoder:
@@ -30,6 +33,8 @@ class StreamDecoder:
     On an invalid byte it slides forward one byte at a time, so a valid frame that follows garbage is never
     lost; a partial frame older than INTER_BYTE_TIMEOUT_MS is dropped. Errors are counted by kind, never raised.
     """
+
+    __slots__ = ("_errors", "_last_ms", "_pending", "_time_fn")  # the per-byte path reads them on every call
 
     def __init__(self, time_fn: Callable[[], float] = time.monotonic) -> None:
         self._time_fn = time_fn
@@ -68,18 +73,30 @@ class StreamDecoder:
         if not data:
             return []
         self._last_ms = now_ms
-        if len(data) == 1 and len(pending) < _LAST_DIGIT:
+        if len(data) == 1:
             # One byte at a time, the usual way a serial port is read: the common cases in a few steps.
             byte = data[0]
-            if not pending:
+            n = len(pending)
+            if n == 0:
                 if byte in BY_BYTES:
                     self._pending = data
                 else:
                     self._errors[ErrorKind.BAD_CATEGORY] += 1
                 return []
-            if (0x30 <= byte <= 0x39) if len(pending) > 1 else (byte in BY_BYTES[pending[0]]):
-                self._pending = pending + data
-                return []
+            if n == 1:
+                if byte in BY_BYTES[pending[0]]:
+                    self._pending = pending + data
+                    return []
+            elif n < _DIGITS_END:
+                if 0x30 <= byte <= 0x39:
+                    self._pending = pending + data
+                    return []
+            elif n == _LAST:  # the frame's last byte: a whole valid frame, or the slow path says what is wrong
+                frame = pending + data
+                command = DECODED.get(frame) or valid(frame)
+                if command is not None:
+                    self._pending = b""
+                    return [command]
         return self._scan(pending + data)
 
     def _scan(self, data: bytes) -> list[Command]:

@@ -17,26 +17,28 @@ export interface Status {
 }
 
 /**
- * One line from the Arduino; `kind` says which fields it has. `status` is null (and a ready line's `integrity`
- * null) only for firmware built before the spec had them.
+ * One line from the Arduino; `kind` says which fields it has. Every line but the ready line carries the drone's
+ * state and laser as the drone confirmed them.
  */
 export type Reply =
-  | { readonly kind: "ready"; readonly protocol: string; readonly fingerprint: string; readonly integrity: string | null }
-  | { readonly kind: "accepted"; readonly command: CommandName; readonly category: Category; readonly direction: Direction; readonly status: Status | null }
-  | { readonly kind: "rejected"; readonly error: ErrorName; readonly status: Status | null }
-  | { readonly kind: "failsafe"; readonly status: Status | null };
+  | { readonly kind: "ready"; readonly protocol: string; readonly fingerprint: string; readonly integrity: string }
+  | { readonly kind: "accepted"; readonly command: CommandName; readonly category: Category; readonly direction: Direction; readonly status: Status }
+  | { readonly kind: "rejected"; readonly error: ErrorName; readonly status: Status }
+  | { readonly kind: "failsafe"; readonly status: Status };
 
 const STATE_BY_CODE = new Map<string, StateName>(
   (Object.keys(STATES) as StateName[]).map((name) => [STATES[name].code, name]),
 );
 
-// The status at the end of `rest`, and what is before it; a rest without one keeps a null status.
-function splitStatus(rest: string): [string, Status | null] {
+// The status at the end of `rest`, and what is before it; a line without one is not a reply of the spec.
+function splitStatus(text: string, rest: string): [string, Status] {
   const at = rest.length - STATUS_SEPARATOR.length - 2;
-  if (at < 0 || rest.slice(at, at + STATUS_SEPARATOR.length) !== STATUS_SEPARATOR) return [rest, null];
   const state = STATE_BY_CODE.get(rest.charAt(rest.length - 2));
   const laser = rest.charAt(rest.length - 1);
-  if (state === undefined || (laser !== LASER_ON && laser !== LASER_OFF)) return [rest, null];
+  if (at < 0 || rest.slice(at, at + STATUS_SEPARATOR.length) !== STATUS_SEPARATOR || state === undefined
+      || (laser !== LASER_ON && laser !== LASER_OFF)) {
+    throw new ProtocolError("bad_reply", `reply ${JSON.stringify(text)} does not end with the drone's status`);
+  }
   return [rest.slice(0, at), { state, laserOn: laser === LASER_ON }];
 }
 
@@ -69,12 +71,12 @@ export function parseReply(line: string | ArrayLike<number>): Reply {
     const rest = text.slice(prefix.length);
     if (kind === "ready") {
       const parts = rest.split(/\s+/).filter((p) => p !== "");
-      if (parts.length === 2 || parts.length === 3) {
-        return { kind, protocol: parts[0] ?? "", fingerprint: parts[1] ?? "", integrity: parts[2] ?? null };
+      if (parts.length === 3) {
+        return { kind, protocol: parts[0] ?? "", fingerprint: parts[1] ?? "", integrity: parts[2] ?? "" };
       }
       throw new ProtocolError("bad_reply", `malformed ${kind} reply ${JSON.stringify(text)}`);
     }
-    const [body, status] = splitStatus(rest);
+    const [body, status] = splitStatus(text, rest);
     if (kind === "accepted") {
       const entry = body.length === 2 ? lookup(body.charCodeAt(0), body.charCodeAt(1)) : undefined;
       if (entry !== undefined) {

@@ -96,8 +96,7 @@ export function startConsole(root: HTMLElement, bridge: string): void {
     }
   }
 
-  const showStatus = (status: Status | null): void => {
-    if (status === null) return;
+  const showStatus = (status: Status): void => {
     const s = STATES[status.state];
     state.textContent = `${s.name}${s.armed ? " (motors may spin)" : ""}, laser ${status.laserOn ? "ON" : "off"}`;
     state.dataset["state"] = s.name;
@@ -108,7 +107,7 @@ export function startConsole(root: HTMLElement, bridge: string): void {
     lastReply.textContent = line;
     if (reply.kind !== "ready") showStatus(reply.status);
     if (reply.kind === "ready") {
-      const integrity = reply.integrity ?? "none";
+      const integrity = reply.integrity;
       trusted = reply.protocol === PROTOCOL_NAME && reply.fingerprint === SPEC_FINGERPRINT && integrity === INTEGRITY;
       ready.textContent = `READY ${reply.protocol} ${reply.fingerprint} ${integrity}: ${trusted ? "the drone runs this spec"
         : `DIFFERENT SPEC (this console: ${PROTOCOL_NAME} ${SPEC_FINGERPRINT} ${INTEGRITY}); sending disabled`}`;
