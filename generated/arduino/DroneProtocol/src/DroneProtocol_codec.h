@@ -118,9 +118,9 @@ class StreamParser {
       last_ms_ = now16;
     }
     // The fast paths: a valid byte at its position (the checks of detail::step(), which the slow path uses),
-    // each a few instructions; anything else goes to reject().
+    // each a few instructions; anything else goes to reject() (a slide never completes a frame).
     if (n >= 2) {
-      if (static_cast<uint8_t>(byte - '0') > 9) return reject(n, byte);
+      if (static_cast<uint8_t>(byte - '0') > 9) return rejected(n, byte);
       digits_[n - 2] = byte;
       if (++n < WIRE_LENGTH) {
         length_ = n;
@@ -128,13 +128,13 @@ class StreamParser {
       }
       // The last byte: the value, then the range check.
       command_.value = detail::value_of(digits_);
-      if (!detail::in_range(command_)) return reject(WIRE_LENGTH, 0);
+      if (!detail::in_range(command_)) return rejected(WIRE_LENGTH, 0);
       length_ = 0;
       return true;
     }
     if (n == 1) {
       CommandIndex index;
-      if (!detail::find_direction(static_cast<uint8_t>(command_.id), byte, index)) return reject(1, byte);
+      if (!detail::find_direction(static_cast<uint8_t>(command_.id), byte, index)) return rejected(1, byte);
       command_.id = static_cast<CommandId>(index);
       command_.direction = byte;
       length_ = 2;
@@ -177,10 +177,16 @@ class StreamParser {
   static constexpr uint8_t COUNTERS = STREAM_ERROR_COUNT + 0;
 
 
+  // The fast paths' way out: reject() is void, so the call sites test no result.
+  DRONE_PROTOCOL_ALWAYS_INLINE bool rejected(uint8_t n, uint8_t byte) {
+    reject(n, byte);
+    return false;
+  }
+
   // `byte` is not valid at position `n` (1 or more), or, with n == WIRE_LENGTH, the complete frame is out of
   // range: count the error, drop the oldest byte and re-check the rest from the start, until they form a valid
   // prefix again (possibly empty). A slide never completes a frame: it leaves fewer than WIRE_LENGTH bytes.
-  DRONE_PROTOCOL_NOINLINE bool reject(uint8_t n, uint8_t byte) {
+  DRONE_PROTOCOL_NOINLINE void reject(uint8_t n, uint8_t byte) {
     uint8_t bytes[WIRE_LENGTH];
     bytes[0] = command_.category;
     bytes[1] = command_.direction;
@@ -201,7 +207,7 @@ class StreamParser {
         if (pos == n) {
           length_ = n;
           for (uint8_t i = 2; i < n; ++i) digits_[i - 2] = from[i];
-          return false;
+          return;
         }
         error = detail::step(command_, pos, from[pos]);
         ++pos;
