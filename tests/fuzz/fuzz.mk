@@ -1,5 +1,6 @@
 # libFuzzer target for the generated C++ StreamParser / decode / encode (tests/fuzz/fuzz_stream_parser.cpp).
-# Included by the top Makefile:  `make fuzz-smoke` (part of `make test`, ~35 s: the shipped spec, then in crc8 mode)  and  `make fuzz` (5 minutes).
+# Included by the top Makefile:  `make fuzz-smoke` (part of `make test`, ~35 s: the shipped spec, then in crc8
+# mode)  and  `make fuzz` (5 minutes).
 # Everything is built into build/fuzz/; the growing corpus stays in build/fuzz/corpus between runs, and a crash
 # leaves its input in build/fuzz/artifacts/ (replay: build/fuzz/fuzz_stream_parser build/fuzz/artifacts/crash-...).
 # With FUZZ_JOBS > 1 each worker logs to build/fuzz/fuzz-N.log.

@@ -330,7 +330,7 @@ struct CommandInfo {
 
 namespace detail {
 // One flash array per attribute (not one array of structs): the linker drops the attributes a sketch never
-// reads, so the parser's own cost is 5 bytes per command (direction byte, minimum, maximum).
+// reads, so the parser's own cost is 2 bytes per command (its direction byte, its range index) and 4 per distinct range.
 constexpr uint8_t CATEGORY_COUNT = 5;
 // The category of a first byte in constant time: a dense table (category index + 1, 0 for none).
 constexpr uint8_t CATEGORY_FIRST = 105;
