@@ -1,11 +1,18 @@
 """The ArUco marker detector, with parameters for the frames a drone sees: blur, the frame's edge, dim light.
 
+Each was chosen on the tuning photos of bench/vision (RESULTS.md has the figures), for recall under motion
+blur and at the frame's edge, zero false positives, and a cost near OpenCV's defaults:
+
 * ``minDistanceToBorder`` 0: a marker touching the frame's edge is still read (OpenCV's default, 3 px,
   drops it just when the drone turns towards it).
-* Adaptive-threshold windows from 3 to 53 px (default up to 23): wide windows keep a blurred marker's
-  cells apart.
+* Two adaptive-threshold windows, 3 and 23 px (OpenCV's default adds 13): the third pass found no marker
+  the other two missed and cost a third of the time.
+* A minimum perimeter in pixels (a side of ``MIN_SIDE_PX``): smaller quads cannot carry a readable 6x6
+  cell grid, and the many tiny contours of a textured room are most of the default's cost.
+* ``polygonalApproxAccuracyRate`` 0.05 (default 0.03): a blurred or clipped marker's outline is rounder.
 * Sub-pixel corner refinement: the centre and the side (hence the range) to a fraction of a pixel.
-* A second look at half resolution when the full frame has no marker: motion blur shrinks with the image.
+* A second look at half resolution when the full frame has no marker: motion blur halves with the image
+  and the look costs a quarter of the first.
 Every marker of the configured id is a candidate; its size must imply a plausible range.
 """
 
@@ -27,12 +34,17 @@ def aruco_dictionary(name: str) -> cv2.aruco.Dictionary:
     return cv2.aruco.getPredefinedDictionary(code)
 
 
-def detector_parameters(adaptive_thresh_constant: float) -> cv2.aruco.DetectorParameters:
+MIN_SIDE_PX = 8  # the smallest marker side searched, pixels of the searched image
+
+
+def detector_parameters(adaptive_thresh_constant: float, searched_width: int = 320) -> cv2.aruco.DetectorParameters:
     params = cv2.aruco.DetectorParameters()
     params.adaptiveThreshConstant = adaptive_thresh_constant
     params.adaptiveThreshWinSizeMin = 3
-    params.adaptiveThreshWinSizeMax = 53
-    params.adaptiveThreshWinSizeStep = 10
+    params.adaptiveThreshWinSizeMax = 23
+    params.adaptiveThreshWinSizeStep = 20
+    params.minMarkerPerimeterRate = min(1.0, 4.0 * MIN_SIDE_PX / max(1, searched_width))
+    params.polygonalApproxAccuracyRate = 0.05
     params.minDistanceToBorder = 0
     params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
     params.cornerRefinementWinSize = 3
@@ -50,12 +62,18 @@ class ArucoMarkerDetector:
         self.marker_id = cfg.marker_id
         self.vision = vision or VisionConfig()
         self.fov_deg = fov_deg
-        self._detector = cv2.aruco.ArucoDetector(
-            aruco_dictionary(cfg.dictionary), detector_parameters(cfg.adaptive_thresh_constant)
-        )
+        self._dictionary = aruco_dictionary(cfg.dictionary)
+        self._detectors: dict[int, cv2.aruco.ArucoDetector] = {}  # per searched width (the minimum perimeter)
+
+    def _detector(self, searched_width: int) -> cv2.aruco.ArucoDetector:
+        det = self._detectors.get(searched_width)
+        if det is None:
+            params = detector_parameters(self.cfg.adaptive_thresh_constant, searched_width)
+            det = self._detectors[searched_width] = cv2.aruco.ArucoDetector(self._dictionary, params)
+        return det
 
     def _markers(self, grey: MatLike, scale: float, width: int) -> list[Candidate]:
-        corners, ids, _ = self._detector.detectMarkers(grey)
+        corners, ids, _ = self._detector(max(grey.shape[:2])).detectMarkers(grey)
         if ids is None or len(corners) == 0:
             return []
         found = []

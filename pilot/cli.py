@@ -41,6 +41,7 @@ EXIT_OK = 0
 EXIT_FAILED = 1
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
+MAX_SIZE = (4096, 4096)  # the simulated camera's largest frame (about 50 MB of BGR)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -97,9 +98,24 @@ def _size(text: str) -> tuple[int, int]:
         w, h = (int(v) for v in text.lower().split("x"))
     except ValueError as exc:
         raise PilotError(f"option --size: expected WIDTHxHEIGHT, got {text!r}") from exc
-    if w < 32 or h < 24:
-        raise PilotError(f"option --size: {text!r} is too small")
+    if not (32 <= w <= MAX_SIZE[0] and 24 <= h <= MAX_SIZE[1]):
+        raise PilotError(
+            f"option --size: {text!r} must be within 32x24..{MAX_SIZE[0]}x{MAX_SIZE[1]} (width x height)"
+        )
     return w, h
+
+
+def _check_args(args: argparse.Namespace) -> None:
+    """Options that bound the flight or feed the link: finite, in range, named when they are not."""
+    checks = (
+        ("--max-seconds", args.max_seconds, 0.0 < args.max_seconds <= 86_400.0, "above 0 and at most 86400"),
+        ("--wind", args.wind, 0.0 <= args.wind <= 50.0, "within 0..50"),
+        ("--baud", args.baud, 0 < args.baud <= 4_000_000, "within 1..4000000"),
+    )
+    for option, value, ok, allowed in checks:
+        if not ok:  # NaN fails every comparison, infinities the upper bounds
+            raise PilotError(f"option {option} must be {allowed}, got {value!r}")
+    _size(args.size)
 
 
 def _roi(text: str | None) -> Roi | None:
@@ -273,6 +289,9 @@ def _fly_real(args: argparse.Namespace, cfg: PilotConfig) -> int:
             status.finish()
     stop_note(live)
     print(f"pilot: {result.reason}; final state {result.state.value}; {tally.summary()}")
+    print(f"pilot: the drone confirmed: {result.confirmed}")
+    if result.port_lost:
+        print(f"pilot: {result.port_lost}", file=sys.stderr)
     for problem in result.shutdown_errors:
         print(f"pilot: during the safe shutdown: {problem}", file=sys.stderr)
     if recorder is not None:
@@ -296,6 +315,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"pilot: saved HSV ranges {cfg.hsv.ranges} to {args.config}; preview {preview_path(args.config)}")
             return EXIT_OK
         check_sources(args)
+        _check_args(args)
         cfg = _load_config(args)
         if args.port and args.sim:
             raise PilotError("options --sim and --port exclude each other")

@@ -10,7 +10,11 @@ States (``State``)::
                                         ^                    |        |      |
                                         +---- target lost ---+--------+------+   (neutral first)
 
-* ARM sends ``arm()`` and waits the firmware's arming hold (``ARMING_HOLD_MS``) plus a margin.
+* The drone's state and laser come from its replies (``DroneView``), never from what was sent. Whenever
+  the confirmed laser differs from what the pilot wants, the deterministic ``laser_on()``/``laser_off()``
+  goes out before anything else, so a lost frame costs one reply round trip.
+* ARM sends ``arm()`` (again whenever the drone reports it disarmed) until the drone confirms an armed
+  state, then waits ``arm_margin_ms``; it gives up if no arming is confirmed in time.
 * TAKEOFF climbs (``move_up``) for ``takeoff_ms``; HOLD sends ``hold_altitude()`` for ``settle_ms``.
 * SEARCH turns (a bounded sweep: ``search_max_ms`` in all, unconfirmed sightings included, then LAND)
   towards the side the target was last seen.
@@ -22,182 +26,39 @@ States (``State``)::
   missed frames during a forward approach keep it going (a far target flickers in and out of detection).
 * AIM holds position and centres the target with the pan/tilt servos; after ``aim_frames`` centred
   frames FIRE switches the laser on. The laser stays on only while the target is found and centred;
-  after ``fire_ms`` lit it is switched off and the drone lands (LAND: ``move_down`` for ``land_ms``,
-  then ``disarm()``). While firing, small errors (within twice the aim tolerance) are still corrected
+  after ``fire_ms`` lit (as the drone confirmed it) it is switched off and the drone lands. While
+  firing, small errors (within twice the aim tolerance) are still corrected
   with the servos; larger ones switch the laser off and go back to AIM.
 * Losing the target (``lost_frames`` misses in a row) in ACQUIRE/TRACK/AIM/FIRE: laser off, sticks
   neutral (``hold_altitude()``), servos reset, and SEARCH again.
+* LAND (also what ``abort()`` leads to): laser off until confirmed, servos home, then the firmware's
+  landing routine (``land()``; ``disarm()`` when the drone is armed on the ground) until the drone
+  confirms a landing, then keep-alives until it confirms not armed with the laser off (DONE). After
+  ``land_ms`` without that confirmation it stops (DONE) and the firmware's failsafe takes over.
 """
 
 from __future__ import annotations
 
-import enum
 import math
 import time
-from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from collections.abc import Callable
 
 import drone_protocol as dp
 
 from .config import ControllerConfig
+from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, speed_for
 from .detection import Detection
 from .gating import Gate
 
-
-class State(enum.Enum):
-    IDLE = "idle"
-    ARM = "arm"
-    TAKEOFF = "takeoff"
-    HOLD = "hold"
-    SEARCH = "search"
-    ACQUIRE = "acquire"
-    TRACK = "track"
-    AIM = "aim"
-    FIRE = "fire"
-    LAND = "land"
-    DONE = "done"
+__all__ = ["FLYING", "LOCKED", "Controller", "State", "Transition"]
 
 
-FLYING = frozenset({State.TAKEOFF, State.HOLD, State.SEARCH, State.ACQUIRE, State.TRACK, State.AIM, State.FIRE})
-LOCKED = frozenset({State.ACQUIRE, State.TRACK, State.AIM, State.FIRE})
-
-
-@dataclass(frozen=True)
-class Transition:
-    t_ms: int
-    old: State
-    new: State
-    reason: str
-
-
-def _speed(command: str, fraction: float) -> int:
-    """A speed for ``command`` at ``fraction`` (0..2) of the spec's speed step beyond its channel median,
-    in the command's own sense and clamped to its allowed range."""
-    spec = dp.COMMANDS[command]
-    median = dp.CHANNELS[spec.target].median
-    default = spec.default if spec.default is not None else median
-    sense = 1 if default >= median else -1
-    value = median + sense * round(dp.SPEED_STEP_US * max(0.0, fraction))
-    return max(spec.minimum, min(spec.maximum, value))
-
-
-class Controller:
-    def __init__(
-        self,
-        config: ControllerConfig | None = None,
-        clock: Callable[[], float] = time.monotonic,
-    ) -> None:
-        self.cfg = config or ControllerConfig()
-        self._clock = clock
+class Controller(ControllerCore):
+    def __init__(self, config: ControllerConfig | None = None, clock: Callable[[], float] = time.monotonic) -> None:
+        super().__init__(config, clock)
         self.gate = Gate(self.cfg)  # vision gate (issue 12): every sighting and every laser-on goes through it
-        self.state = State.IDLE
-        self.transitions: list[Transition] = []
-        self.laser_on = False
-        self.lit_ms = 0  # total time the laser has been on
-        self.fired = False  # the laser was on at the target for the whole fire time
-        self.last_command: bytes | None = None
-        self._entered_ms = self._now()
-        self._hits = 0
-        self._misses = 0
-        self._centred = 0
-        self._search_sign = 1  # +1 right, -1 left
-        self._fire_started_ms = 0
-        self._laser_since_ms = 0
-        self._sent_entry = False
-        self._airborne_at_abort = False
-        self._coast: bytes | None = None
-        self._search_started_ms = self._now()
-        self._pan_offset = 0  # degrees the pilot has moved the pan servo from its default
-        self._tilt_offset = 0
-        tan_h = math.tan(math.radians(self.cfg.horizontal_fov_deg) / 2.0)
-        self._tan_h = tan_h
 
-    # -- helpers -----------------------------------------------------------------------------
-    def _now(self) -> int:
-        return round(self._clock() * 1000.0)
-
-    def _elapsed(self) -> int:
-        return self._now() - self._entered_ms
-
-    def _go(self, new: State, reason: str) -> None:
-        if new is self.state:
-            return
-        self.transitions.append(Transition(self._now(), self.state, new, reason))
-        if new is State.SEARCH and self.state is not State.ACQUIRE:
-            self._search_started_ms = self._now()  # a sighting that is not confirmed does not restart the sweep
-        self.state = new
-        self._entered_ms = self._now()
-        self._sent_entry = False
-        self._hits = 0 if new is State.SEARCH else self._hits
-        self._misses = 0
-        self._coast = None
-        self._centred = 0
-
-    def _emit(self, frame: bytes) -> bytes:
-        self.last_command = frame
-        return frame
-
-    def _laser(self, on: bool) -> bytes | None:
-        if self.laser_on == on:
-            return None
-        now = self._now()
-        if self.laser_on:
-            self.lit_ms += now - self._laser_since_ms
-        self.laser_on = on
-        self._laser_since_ms = now
-        return self._emit(dp.laser_toggle())
-
-    @property
-    def flying(self) -> bool:
-        return self.state in FLYING or self.state is State.ARM
-
-    # -- external events -----------------------------------------------------------------------
-    def start(self) -> None:
-        if self.state is State.IDLE:
-            self._go(State.ARM, "start")
-
-    def on_reply(self, reply: dp.Reply) -> None:
-        """Firmware replies: a failsafe switched the laser off; a refused movement means not armed."""
-        if reply.kind is dp.ReplyKind.FAILSAFE:
-            if self.laser_on:
-                self.lit_ms += self._now() - self._laser_since_ms
-            self.laser_on = False
-            if self.state in FLYING:
-                self._go(State.LAND, "firmware failsafe")
-        elif (
-            reply.kind is dp.ReplyKind.REJECTED
-            and reply.error is dp.ErrorKind.NOT_ARMED
-            and self.state in FLYING
-        ):
-            self._go(State.LAND, "firmware says not armed")
-
-    def abort(self, reason: str) -> None:
-        """Stop the mission: the caller then sends ``safe_steps()``."""
-        self._airborne_at_abort = self.state in FLYING or self.state is State.LAND
-        if self.state not in (State.DONE, State.IDLE):
-            self._go(State.DONE, f"abort: {reason}")
-
-    def safe_steps(self) -> Iterator[bytes]:
-        """What goes on the wire before exit, one frame per tick: laser off (if on), sticks neutral,
-        servos home; if it was flying, down for ``land_ms`` (the flight controller disarms only on the
-        ground, after the sticks are held there); then disarm. Timed on the injected clock."""
-        off = self._laser(False)
-        if off is not None:
-            yield off
-        yield self._emit(dp.hold_altitude())
-        self._pan_offset = self._tilt_offset = 0
-        yield self._emit(dp.servo_reset())
-        if self._airborne_at_abort:
-            start = self._now()
-            for _ in range(self.cfg.land_ms // 5 + 1):  # bounded even if the clock stands still
-                if self._now() - start >= self.cfg.land_ms:
-                    break
-                yield self._emit(dp.move_down(_speed("move_down", 1.5)))
-        yield self._emit(dp.disarm())
-
-    # -- the state machine -----------------------------------------------------------------------
-    def update(self, det: Detection | None) -> bytes | None:
-        """One frame's decision. ``det`` is None when there is no frame this tick."""
+    def _decide(self, det: Detection | None) -> bytes | None:
         # -- vision gate (issue 12): a bad frame holds (laser off), too many in a row land ------------
         self.gate.observe(det)
         if self.gate.fault is not None and self.state in FLYING - {State.TAKEOFF, State.HOLD}:
@@ -208,36 +69,7 @@ class Controller:
             off = self._laser(False)
             return off if off is not None else self._emit(dp.hold_altitude())
         # -- end of the vision gate --------------------------------------------------------------------
-        handler = getattr(self, f"_on_{self.state.value}")
-        result: bytes | None = handler(det)
-        return result
-
-    def _on_idle(self, det: Detection | None) -> bytes | None:
-        return None
-
-    def _on_done(self, det: Detection | None) -> bytes | None:
-        return None
-
-    def _on_arm(self, det: Detection | None) -> bytes | None:
-        if not self._sent_entry:
-            self._sent_entry = True
-            return self._emit(dp.arm())
-        if self._elapsed() >= dp.ARMING_HOLD_MS + self.cfg.arm_margin_ms:
-            self._go(State.TAKEOFF, "armed")
-            return self._on_takeoff(det)
-        return None
-
-    def _on_takeoff(self, det: Detection | None) -> bytes | None:
-        if self._elapsed() >= self.cfg.takeoff_ms:
-            self._go(State.HOLD, "take-off climb done")
-            return self._on_hold(det)
-        return self._emit(dp.move_up(_speed("move_up", 1.0)))
-
-    def _on_hold(self, det: Detection | None) -> bytes | None:
-        if self._elapsed() >= self.cfg.settle_ms:
-            self._go(State.SEARCH, "altitude held")
-            return self._on_search(det)
-        return self._emit(dp.hold_altitude())
+        return super()._decide(det)
 
     def _found(self, det: Detection | None) -> bool:
         return det is not None and det.found and self.gate.acquired()  # vision gate: confident enough
@@ -253,8 +85,8 @@ class Controller:
             self._pan_offset = self._tilt_offset = 0
             return self._emit(dp.servo_reset())
         if self._search_sign > 0:
-            return self._emit(dp.turn_right(_speed("turn_right", 1.0)))
-        return self._emit(dp.turn_left(_speed("turn_left", 1.0)))
+            return self._emit(dp.turn_right(speed_for(dp.CommandName.TURN_RIGHT, 1.0)))
+        return self._emit(dp.turn_left(speed_for(dp.CommandName.TURN_LEFT, 1.0)))
 
     def _lost(self, det: Detection | None, limit: int) -> bool:
         if self._found(det):
@@ -302,18 +134,18 @@ class Controller:
         if abs(ex) > cfg.dead_band_x:
             frac = 0.35 + 0.65 * min(1.0, abs(ex) / 0.5)
             if ex > 0:
-                return self._emit(dp.turn_right(_speed("turn_right", frac)))
-            return self._emit(dp.turn_left(_speed("turn_left", frac)))
+                return self._emit(dp.turn_right(speed_for(dp.CommandName.TURN_RIGHT, frac)))
+            return self._emit(dp.turn_left(speed_for(dp.CommandName.TURN_LEFT, frac)))
         if abs(ey) > cfg.dead_band_y:
             frac = 0.5 + 0.5 * min(1.0, abs(ey) / 0.6)
             if ey < 0:
-                return self._emit(dp.move_up(_speed("move_up", frac)))
-            return self._emit(dp.move_down(_speed("move_down", frac)))
+                return self._emit(dp.move_up(speed_for(dp.CommandName.MOVE_UP, frac)))
+            return self._emit(dp.move_down(speed_for(dp.CommandName.MOVE_DOWN, frac)))
         if size >= cfg.approach_size:
             self._go(State.AIM, f"close enough (size {size:.3f})")
             return self._on_aim(det)
         frac = 1.8 if size < 0.45 * cfg.approach_size else (1.0 if size < 0.75 * cfg.approach_size else 0.6)
-        self._coast = self._emit(dp.move_forward(_speed("move_forward", frac)))
+        self._coast = self._emit(dp.move_forward(speed_for(dp.CommandName.MOVE_FORWARD, frac)))
         return self._coast
 
     def _remember_side(self, det: Detection) -> None:
@@ -364,7 +196,11 @@ class Controller:
         return self._emit(dp.hold_altitude())
 
     def _on_fire(self, det: Detection | None) -> bytes | None:
-        lit_now = self.lit_ms + (self._now() - self._laser_since_ms if self.laser_on else 0)
+        lit_now = self.lit_ms
+        if lit_now < self.cfg.fire_ms and self._now() - self._fire_started_ms >= 4 * self.cfg.fire_ms:
+            off = self._laser(False)
+            self._go(State.LAND, f"laser confirmed on for only {lit_now} ms")
+            return off if off is not None else self._on_land(det)
         if lit_now >= self.cfg.fire_ms:
             self.fired = True
             off = self._laser(False)
@@ -392,15 +228,3 @@ class Controller:
         # still within the loose tolerance: keep centring it (a drifting drone), the laser stays on
         correction = self._servo_correction(det)
         return correction if correction is not None else self._emit(dp.hold_altitude())
-
-    def _on_land(self, det: Detection | None) -> bytes | None:
-        off = self._laser(False)
-        if off is not None:
-            return off
-        if self._pan_offset or self._tilt_offset:
-            self._pan_offset = self._tilt_offset = 0
-            return self._emit(dp.servo_reset())
-        if self._elapsed() >= self.cfg.land_ms:
-            self._go(State.DONE, "landed")
-            return self._emit(dp.disarm())
-        return self._emit(dp.move_down(_speed("move_down", 1.5)))

@@ -19,6 +19,10 @@ class LinkError(PilotError, ConnectionError):
     """The serial link to the drone failed."""
 
 
+class PortLost(LinkError):
+    """The serial port vanished (or failed) and could not be reopened: nothing more can reach the drone."""
+
+
 class ReadyTimeout(LinkError, TimeoutError):
     """The firmware's ready line did not arrive in time."""
 

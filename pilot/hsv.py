@@ -1,40 +1,82 @@
-"""The colour-ball detector: every blob of the target's colour, scored on shape, colour purity and size.
+"""The colour-ball detector: every blob of the target's colour, scored on shape, colour purity, isolation and size.
 
-Mask: one ``cvtColor`` and one ``inRange``, the floor any colour detector pays. Red wraps around hue 0,
-which would need two ranges; converting the BGR frame as if it were RGB mirrors the hue circle
-(h -> 120 - h, in OpenCV's 0..179 units) and puts red at 120, in one piece. A 3x3 opening removes speckle.
+Search, then refine (the cost stays near the floor any colour detector pays, one ``cvtColor`` and one
+``inRange`` on the frame):
 
-Candidates (the largest few external contours) are scored 0..1, each factor a ramp between a value that
-no target shows and one that every target shows (bench/vision/RESULTS.md has the figures):
+1. Search: the frame at half resolution (from 320 px wide up; a 16 px target is still 8 px there),
+   one ``cvtColor``, one ``inRange``, a 3x3 opening, external contours; blobs filling too little of
+   their box's disc (``SEARCH_FILL``) are not refined. Red wraps around hue 0, which would need two
+   ranges; converting the BGR frame as if it were RGB mirrors the hue circle (h -> 120 - h, in OpenCV's
+   0..179 units) and puts red at 120, in one piece. The value (V) bound follows the frame's exposure: in
+   a frame whose brightest pixels are dim, it drops in proportion (never below ``V_FLOOR``), so that a
+   ball's shaded side stays in the mask and the fitted circle stays on the ball.
+2. Refine: the few largest blobs are looked at again at full resolution, in a window around each: a 3x3
+   median (sensor noise in a ball's shaded side would fray its outline), mask, 3x3 opening and closing,
+   the blob's contours, and a score 0..1 each, a product of ramps each between a value no target shows
+   and one every target shows (chosen on the tuning photos of bench/vision); measuring stops as soon as
+   the geometry alone scores below ``hsv.min_score``:
 
-* shape: the share of the contour lying on its minimum enclosing circle ("arc support": a disk ~1, a
-  disk with 30 % hidden behind an edge ~0.7, a square or a rectangle ~0.2), solidity (contour area over
-  its convex hull), and fill of that circle. The circle, not the blob's centroid, gives the position:
-  a ball's dark side or a covered part moves a centroid, not the circle through its lit rim.
-* colour purity: mean saturation, and how far the mean hue sits from the middle of the range
-  (orange and red-brown sit near its edge, the target's red in the middle).
-* size: the range the apparent diameter implies (known diameter, field of view) must be plausible.
+   * shape: the share of the contour lying on its minimum enclosing circle ("arc support": a disk ~1, a
+     disk with 30 % hidden behind an edge ~0.7, a square ~0.3), solidity, fill of that circle, and the
+     aspect of its minimum-area rectangle (a rotated bar has a square bounding box).
+   * colour purity: mean saturation, and how far the mean hue sits from the middle of the range (orange
+     and red-brown sit near its edge, the target's red in the middle).
+   * isolation: the share of the ring around the circle (1.25 to 1.75 radii) that is of the target's
+     colour: a ball stands apart; a hole in a red poster's print, a piece of a red box or of a brick wall
+     does not.
+   * size: the range the apparent diameter implies (known diameter, field of view) must be plausible, and
+     a blob under 16 px is scored down (too few pixels to show its shape).
+
+   The circle, not the blob's centroid, gives the position: a ball's dark side or a covered part moves
+   a centroid, not the circle through its rim.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import cv2
 import numpy as np
+import numpy.typing as npt
 from cv2.typing import MatLike
 
 from .config import HsvConfig, VisionConfig
 from .detection import Candidate, Detection, frame_size, range_of
 from .errors import ConfigError
 
-MAX_CANDIDATES = 6  # the largest blobs scored in full; smaller ones cannot be the nearest target
+MAX_CANDIDATES = 4  # the largest search blobs refined; smaller ones cannot be the nearest target
+SEARCH_FILL = 0.45  # below FILL's zero: the search's coarser outline never rejects what the refinement keeps
+BLOBS_PER_BOX = 2  # blobs measured in one search blob's window (noise can join two at half resolution)
+SEARCH_MIN_WIDTH = 320  # frames at least this wide are searched at half resolution
+V_REFERENCE = 200.0  # brightness (see _exposure) of a well-exposed frame; the V bound scales below it
+V_FLOOR = 24  # the V bound never drops below this: under it hue and saturation are noise
 # score ramps (zero, one), set on the tuning photos only (bench/vision/RESULTS.md)
-ARC = (0.25, 0.5)
+ARC = (0.3, 0.6)
 SOLIDITY = (0.7, 0.88)
 FILL = (0.35, 0.6)
+ELONGATION = (2.0, 1.4)  # minimum-area rectangle, longer side over shorter (falling ramp)
 HUE_OFF = (0.5, 0.95)  # mean hue's distance from the range's middle, in half-widths
-MAX_ASPECT = 2.2  # bounding box, longer side over shorter: a ball half covered is still under 2
+RING = (0.35, 0.1)  # share of the ring of the target's colour (falling ramp)
+SIZE = (8.0, 16.0)  # diameter, pixels: a smaller blob has too few pixels to show its shape
+
+
+Bounds = list[tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]]  # inRange's lower and upper HSV triples
+
+
+class Features(NamedTuple):
+    """What the score of one blob is made of (bench/vision tunes the ramps on these)."""
+
+    cx: float
+    cy: float
+    size: float  # diameter of the fitted circle, pixels
+    arc: float
+    solidity: float
+    fill: float
+    elongation: float
+    saturation: float  # mean, 0..255
+    hue_off: float  # mean hue's distance from the range's middle, in half-widths
+    ring: float
 
 
 def _ramp(value: float, zero: float, one: float) -> float:
@@ -62,17 +104,19 @@ class HsvBlobDetector:
         sv = {(lo[1:], hi[1:]) for lo, hi in cfg.ranges}
         mirrored = {(120 - h) % 180 for h in hues}
         self._code = cv2.COLOR_BGR2HSV
-        self._ranges = [(np.array(lo, np.uint8), np.array(hi, np.uint8)) for lo, hi in cfg.ranges]
+        ranges = [(np.array(lo, np.uint8), np.array(hi, np.uint8)) for lo, hi in cfg.ranges]
         span = _contiguous(hues)
         if span is None and _contiguous(mirrored) is not None:
             span, self._code = _contiguous(mirrored), cv2.COLOR_RGB2HSV
         if span is not None and len(sv) == 1:
             ((s_lo, v_lo), (s_hi, v_hi)), = sv
-            self._ranges = [(np.array((span[0], s_lo, v_lo), np.uint8), np.array((span[1], s_hi, v_hi), np.uint8))]
+            ranges = [(np.array((span[0], s_lo, v_lo), np.uint8), np.array((span[1], s_hi, v_hi), np.uint8))]
+        self._ranges = ranges
         # colour purity refers to the hue range's middle and half-width (in the space the mask uses)
         used = hues if self._code == cv2.COLOR_BGR2HSV else mirrored
         self._hue_mid = (min(used) + max(used)) / 2.0
         self._hue_half = max(1.0, (max(used) - min(used)) / 2.0)
+        self._width = 320  # of the frame being looked at (range estimates)
         self._sat_lo = float(min(lo[1] for lo, _ in cfg.ranges))
         k = max(1, cfg.open_kernel)
         self._kernel = cv2.getStructuringElement(cv2.MORPH_RECT, (k, k)) if k > 1 else None
@@ -82,65 +126,145 @@ class HsvBlobDetector:
         """True when the mask costs one cvtColor and one inRange (contiguous hues, shared S/V bounds)."""
         return len(self._ranges) == 1
 
-    def _hsv(self, image: MatLike) -> MatLike:
-        return cv2.cvtColor(image, self._code)
+    # -- masks --------------------------------------------------------------------------------------
+    def _exposure(self, image: MatLike) -> float:
+        """The frame's brightness: a high order statistic of every channel on a sparse grid (a few µs)."""
+        step = max(4, image.shape[1] // 40)  # about 40x30 samples at any frame size
+        grid = np.asarray(image[::step, ::step]).reshape(-1)
+        k = max(1, grid.size // 50)  # the 98th percentile, without a sort
+        return float(np.partition(grid, grid.size - k)[grid.size - k])
 
-    def _mask_of(self, hsv: MatLike) -> MatLike:
-        lo, hi = self._ranges[0]
-        mask = cv2.inRange(hsv, lo, hi)
-        for lo, hi in self._ranges[1:]:
+    def _bounds(self, exposure: float) -> Bounds:
+        gain = min(1.0, exposure / V_REFERENCE)
+        if gain >= 1.0:
+            return self._ranges
+        out = []
+        for lo, hi in self._ranges:
+            adapted = lo.copy()
+            adapted[2] = max(min(int(lo[2]), V_FLOOR), round(int(lo[2]) * gain))
+            out.append((adapted, hi))
+        return out
+
+    def _raw_mask(self, image: MatLike, bounds: Bounds) -> MatLike:
+        return self._in_range(cv2.cvtColor(image, self._code), bounds)
+
+    @staticmethod
+    def _in_range(hsv: MatLike, bounds: Bounds) -> MatLike:
+        mask = cv2.inRange(hsv, bounds[0][0], bounds[0][1])
+        for lo, hi in bounds[1:]:
             mask = cv2.bitwise_or(mask, cv2.inRange(hsv, lo, hi))
-        if self._kernel is not None:
-            # opening: speckle goes; closing: a noisy target's pinholes and ragged rim are mended
-            mask = cv2.morphologyEx(cv2.morphologyEx(mask, cv2.MORPH_OPEN, self._kernel), cv2.MORPH_CLOSE, self._kernel)
         return mask
 
-    def mask(self, image: MatLike) -> MatLike:
-        return self._mask_of(self._hsv(image))
+    def _clean(self, mask: MatLike) -> MatLike:
+        if self._kernel is None:
+            return mask
+        # opening: speckle goes; closing: a noisy target's pinholes and ragged rim are mended
+        return cv2.morphologyEx(cv2.morphologyEx(mask, cv2.MORPH_OPEN, self._kernel), cv2.MORPH_CLOSE, self._kernel)
 
-    def candidates(self, image: MatLike) -> list[Candidate]:
-        hsv = self._hsv(image)
-        mask = self._mask_of(hsv)
-        contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
-        blobs = []
+    def mask(self, image: MatLike) -> MatLike:
+        """The full-resolution mask (with the exposure-adapted V bound), as the refinement sees it."""
+        return self._clean(self._raw_mask(image, self._bounds(self._exposure(image))))
+
+    # -- candidates ---------------------------------------------------------------------------------
+    def features(self, image: MatLike) -> list[Features]:
+        """Every refined blob's features (unscored)."""
+        w, h = frame_size(image)
+        self._width = w
+        bounds = self._bounds(self._exposure(image))
+        scale = 2 if w >= SEARCH_MIN_WIDTH else 1
+        small = cv2.resize(image, (w // scale, h // scale), interpolation=cv2.INTER_AREA) if scale > 1 else image
+        mask = self._raw_mask(small, bounds)
+        if self._kernel is not None:
+            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, self._kernel)
+        contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+        min_area = self.cfg.min_area / (scale * scale)
+        boxes = []
         for c in contours:
-            if len(c) < 12:  # a blob of min_area >= 4 px whose outline is this short is speckle or a line
+            if len(c) < 3 or (area := cv2.contourArea(c)) < min_area:
                 continue
-            area = cv2.contourArea(c)
-            if area >= self.cfg.min_area:
-                blobs.append((area, c))
-        blobs.sort(key=lambda b: b[0], reverse=True)
-        width = frame_size(image)[0]
-        found = []
-        for area, c in blobs[:MAX_CANDIDATES]:
-            cand = self._score(hsv, mask, c, area, width)
-            if cand is not None and cand.score >= self.cfg.min_score:
-                found.append(cand)
-        found.sort(key=lambda c: c.score, reverse=True)
+            x, y, bw, bh = cv2.boundingRect(c)
+            # a blob filling less than SEARCH_FILL of its box's disc cannot hold a ball the refinement would take
+            if area >= SEARCH_FILL * math.pi * (max(bw, bh) / 2.0) ** 2:
+                boxes.append((area, (x, y, bw, bh)))
+        boxes.sort(key=lambda b: b[0], reverse=True)
+        found: list[Features] = []
+        for _, (x, y, bw, bh) in boxes[:MAX_CANDIDATES]:
+            box = (x * scale, y * scale, bw * scale, bh * scale)
+            for f in self._refine(image, bounds, box):
+                if all(abs(f.cx - g.cx) > 1.0 or abs(f.cy - g.cy) > 1.0 for g in found):
+                    found.append(f)
         return found
 
-    def _score(self, hsv: MatLike, mask: MatLike, c: MatLike, area: float, width: int) -> Candidate | None:
-        x, y, w, h = cv2.boundingRect(c)
-        if max(w, h) > MAX_ASPECT * min(w, h):
-            return None
+    def _refine(self, image: MatLike, bounds: Bounds, box: tuple[int, int, int, int]) -> list[Features]:
+        """The blobs of a search box at full resolution (a search blob may be several joined by noise), in a
+        window that also holds their rings."""
+        w, h = frame_size(image)
+        bx, by, bw, bh = box
+        pad = max(bw, bh) // 2 + 4  # a ring reaches 1.75 radii; the search rounds by a pixel or two
+        x0, y0, x1, y1 = max(0, bx - pad), max(0, by - pad), min(w, bx + bw + pad), min(h, by + bh + pad)
+        # smoothed: sensor noise in a ball's shaded side would fray its outline and the shape with it
+        roi = cv2.medianBlur(np.ascontiguousarray(image[y0:y1, x0:x1]), 3)
+        hsv = cv2.cvtColor(roi, self._code)
+        mask = self._clean(self._in_range(hsv, bounds))
+        contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+        blobs = [(a, c) for c in contours if len(c) >= 8 and (a := float(cv2.contourArea(c))) >= self.cfg.min_area]
+        blobs.sort(key=lambda b: b[0], reverse=True)
+        found = (self._measure(hsv, mask, c, area, x0, y0) for area, c in blobs[:BLOBS_PER_BOX])
+        return [f for f in found if f is not None]
+
+    def _measure(self, hsv: MatLike, mask: MatLike, c: MatLike, area: float, x0: int, y0: int) -> Features | None:
+        """The blob's features; None as soon as its geometry alone scores below ``min_score``."""
         (cx, cy), r = cv2.minEnclosingCircle(c)
         size = 2.0 * r + 1.0  # the circle passes through pixel centres; the ball covers the pixels
-        distance = range_of(size, self.cfg.target_diameter_m, width, self.fov_deg)
-        if not self.vision.range_min_m <= distance <= self.vision.range_max_m:
+        (_, _), (rw, rh), _ = cv2.minAreaRect(c)
+        elongation = max(rw, rh) / max(1e-6, min(rw, rh))
+        fill = area / (math.pi * r * r) if r > 0 else 0.0
+        geometry = self._size_score(size, self._width) * _ramp(fill, *FILL)
+        geometry *= _ramp(elongation, *ELONGATION)
+        if geometry <= 0.0 or geometry < self.cfg.min_score:
             return None
         pts = np.asarray(c, np.float32).reshape(-1, 2)
         gap = np.abs(np.hypot(pts[:, 0] - cx, pts[:, 1] - cy) - r)
         arc = float(np.count_nonzero(gap <= max(1.5, 0.12 * r))) / len(pts)
         hull = float(cv2.contourArea(cv2.convexHull(c)))
         solidity = area / hull if hull > 0 else 0.0
-        fill = area / (math.pi * r * r) if r > 0 else 0.0
-        shape = _ramp(arc, ARC[0], ARC[1]) * _ramp(solidity, SOLIDITY[0], SOLIDITY[1]) * _ramp(fill, FILL[0], FILL[1])
-        if shape <= 0.0:
+        geometry *= _ramp(arc, *ARC) * _ramp(solidity, *SOLIDITY)
+        if geometry <= 0.0 or geometry < self.cfg.min_score:
             return None
-        mean, _ = cv2.meanStdDev(hsv[y : y + h, x : x + w], mask=mask[y : y + h, x : x + w])
-        hue_off = abs(float(mean[0][0]) - self._hue_mid) / self._hue_half
-        colour = _ramp(float(mean[1][0]), self._sat_lo, self._sat_lo + 50.0) * (1.0 - _ramp(hue_off, *HUE_OFF))
-        return Candidate(cx, cy, size, shape * colour)
+        blob = np.zeros_like(mask)
+        cv2.drawContours(blob, [c], 0, 255, -1)
+        mean = cv2.mean(hsv, mask=cv2.bitwise_and(mask, blob))
+        ring = np.zeros_like(mask)
+        # the ring from 1.25 to 1.75 radii (a circle of radius 1.5 r, 0.5 r thick), centre to 1/16 px
+        cv2.circle(ring, (round(cx * 16), round(cy * 16)), round(24 * r), 255, max(2, round(0.5 * r)), cv2.LINE_8, 4)
+        ring_px = cv2.countNonZero(ring)
+        other = cv2.countNonZero(cv2.bitwise_and(ring, cv2.bitwise_and(mask, cv2.bitwise_not(blob))))
+        return Features(
+            cx + x0, cy + y0, size, arc, solidity, fill, elongation, float(mean[1]),
+            abs(float(mean[0]) - self._hue_mid) / self._hue_half, other / ring_px if ring_px else 1.0,
+        )
+
+    def _size_score(self, size: float, width: int) -> float:
+        distance = range_of(size, self.cfg.target_diameter_m, width, self.fov_deg)
+        if not self.vision.range_min_m <= distance <= self.vision.range_max_m:
+            return 0.0
+        return _ramp(size, *SIZE)
+
+    def score(self, f: Features, width: int) -> float:
+        shape = _ramp(f.arc, *ARC) * _ramp(f.solidity, *SOLIDITY) * _ramp(f.fill, *FILL)
+        shape *= _ramp(f.elongation, *ELONGATION) * self._size_score(f.size, width)
+        colour = _ramp(f.saturation, self._sat_lo, self._sat_lo + 50.0) * (1.0 - _ramp(f.hue_off, *HUE_OFF))
+        return shape * colour * _ramp(f.ring, *RING)
+
+    def candidates(self, image: MatLike) -> list[Candidate]:
+        width = frame_size(image)[0]
+        found = []
+        for f in self.features(image):
+            s = self.score(f, width)
+            if s > 0.0 and s >= self.cfg.min_score:
+                found.append(Candidate(f.cx, f.cy, f.size, s))
+        found.sort(key=lambda c: c.score, reverse=True)
+        return found
 
     def detect(self, image: MatLike) -> Detection:
         """This frame alone, best candidate (no tracking, no frame checks: see ``pilot.detect.make_detector``)."""

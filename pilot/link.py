@@ -7,7 +7,9 @@
 * ``poll()`` reads whatever replies have arrived, parses each line with ``parse_reply`` and logs it;
   lines are bounded, garbage is logged and dropped.
 * A failed read or write closes the port and reopens it within ``reconnect_s``, waiting for the ready
-  line again. Meanwhile nothing is sent: the firmware's own failsafe keeps the drone safe.
+  line again. Meanwhile nothing is sent: the firmware's own failsafe keeps the drone safe. If the port
+  is not back in time, ``PortLost`` is raised, and every later ``send`` raises it at once: nothing more
+  can reach the drone, so nothing pretends to.
 
 The link is a context manager; ``close()`` is safe to call twice.
 """
@@ -25,7 +27,7 @@ import drone_protocol as dp
 import serial
 
 from .closing import Closing
-from .errors import FingerprintMismatch, LinkError, ReadyTimeout
+from .errors import FingerprintMismatch, LinkError, PortLost, ReadyTimeout
 
 MAX_LINE = 128
 
@@ -184,6 +186,8 @@ class Link(Closing):
         """Write one frame. Returns False when the port failed and could not be reopened in time."""
         if self._closed:
             raise LinkError(f"link {self.name!r}: send after close")
+        if self._port is None:
+            raise PortLost(f"serial port {self.name!r} is gone (lost earlier and not reopened)")
         self.last_send_t = self._clock()
         try:
             self._port.write(frame)
@@ -225,7 +229,8 @@ class Link(Closing):
     def _recover(self) -> bool:
         """Close and reopen the port within ``reconnect_s``; wait for the ready line again."""
         if self._url is None:
-            raise LinkError(f"link {self.name!r}: the port failed and this link cannot reopen it")
+            self._close_port()
+            raise PortLost(f"serial port {self.name!r} failed and this link cannot reopen it")
         self._close_port()
         deadline = self._ready_clock() + self.reconnect_s
         delay = 0.05
@@ -246,7 +251,7 @@ class Link(Closing):
                 self._close_port()
                 self._ready_sleep(delay)
                 delay = min(0.5, delay * 2)
-        raise LinkError(f"link {self.name!r}: lost and not back within {self.reconnect_s:.1f} s")
+        raise PortLost(f"serial port {self.name!r} lost and not back within {self.reconnect_s:.1f} s")
 
     # -- closing ----------------------------------------------------------------------------------
     def _close_port(self) -> None:

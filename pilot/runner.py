@@ -3,11 +3,17 @@
 The same loop flies the real drone (a camera, a serial link, wall-clock pacing) and the simulated
 one (the simulated camera, the virtual drone's pty, the world's stepped clock as the pacer).
 
+Each tick reads the replies first (the pilot's view of the drone is what they confirm), then decides and
+sends one frame.
+
 Safety: whatever ends the loop — the mission done, the time limit, the end of a video, a lost camera,
 Ctrl-C/SIGTERM (``KeyboardInterrupt``), or an exception in any stage (source, detector, controller,
-link, observers) — the controller's safe steps go on the wire before ``run`` returns, one per tick:
-laser off (if on), sticks neutral, servos home, down until landed (if it was flying), disarm; then
-keep-alives while the firmware's disarm sequence runs.
+link, observers) — the controller lands before ``run`` returns, one frame per tick: laser off until
+confirmed, servos home, the firmware's landing routine, keep-alives until the drone confirms it is not
+armed (or the landing time passes). A second Ctrl-C/SIGTERM while landing cuts that to the shortest
+sequence the firmware accepts (laser off, land, until confirmed disarmed, or no answer for the failsafe
+time); a third stops sending at once. A lost serial port ends the run at once: nothing can reach the
+drone, and the result says when its failsafe fires.
 """
 
 from __future__ import annotations
@@ -24,7 +30,7 @@ import drone_protocol as dp
 
 from .controller import Controller, State
 from .detect import Detection, Detector
-from .errors import FrameSourceError
+from .errors import FrameSourceError, PortLost
 from .sources import Frame, FrameSource
 
 
@@ -99,7 +105,9 @@ class Tick:
     replies: tuple[dp.Reply, ...]
     frame_t: float  # when the frame arrived (the wall clock)
     sent_t: float | None  # when its command's last byte was written and flushed (the wall clock), if any
-    laser_on: bool = False  # what the pilot believes of the laser after this tick
+    laser_on: bool | None = None  # the laser as the drone's replies confirmed it (None: no status yet)
+    drone: str = ""  # the drone's state as its replies confirmed it
+    armed: bool | None = None  # armed as the drone's replies confirmed it
 
 
 class Observer(Protocol):
@@ -115,6 +123,9 @@ class RunResult:
     error: BaseException | None = None
     safe_frames: list[bytes] = field(default_factory=list)
     shutdown_errors: list[str] = field(default_factory=list)
+    confirmed: str = ""  # what the drone last confirmed (its state and laser)
+    safe: bool = False  # the drone confirmed not armed and laser off
+    port_lost: str = ""  # the one line to print when the serial port vanished
 
 
 class StatusLine:
@@ -126,7 +137,7 @@ class StatusLine:
         # on a terminal the line is rewritten in place; elsewhere (a log, make) one line per state change
         self.live = out.isatty() if live is None else live
         self._last = -math.inf
-        self._state: State | None = None
+        self._state: tuple[State, str] | None = None
         self._sends: deque[float] = deque()
         self._t0: float | None = None  # the first tick: times are printed from the start of the run
 
@@ -135,8 +146,8 @@ class StatusLine:
             self._sends.append(tick.t)
         while self._sends and self._sends[0] <= tick.t - 1.0:
             self._sends.popleft()
-        changed = tick.state is not self._state
-        self._state = tick.state
+        changed = (tick.state, tick.drone) != self._state
+        self._state = (tick.state, tick.drone)
         if self.live and tick.t - self._last < self.every_s and not changed:
             return
         if not self.live and not changed:
@@ -147,7 +158,7 @@ class StatusLine:
         seen = "yes" if tick.detection is not None and tick.detection.found else "no "
         last = tick.command.decode("ascii") if tick.command else "      "
         line = (f"t {tick.t - self._t0:7.2f}s  state {tick.state.value:8s}  target {seen}  "
-                f"{len(self._sends):3d} cmd/s  last {last}")
+                f"{len(self._sends):3d} cmd/s  last {last}  drone {tick.drone or '?'}")
         self.out.write(f"\r{line}" if self.live else f"{line}\n")
         self.out.flush()
 
@@ -171,7 +182,7 @@ def run(
 ) -> RunResult:
     watchers = list(observers)
     start = pacer.now()
-    last_send = -math.inf
+    link = _LinkState(pacer.now())
     ticks = 0
     reason = ""
     error: BaseException | None = None
@@ -182,6 +193,7 @@ def run(
             if now - start >= max_seconds:
                 reason = f"time limit ({max_seconds:g} s)"
                 break
+            replies = _poll(sink, controller)
             frame = source.read()
             frame_wall = wall_clock()  # the frame has arrived
             if frame is None:
@@ -189,19 +201,11 @@ def run(
                 break
             det = detector.detect(frame.image)
             command = controller.update(det)
-            if command is None and (now - last_send) * 1000.0 >= keepalive_ms and controller.state is not State.DONE:
-                command = dp.hold_altitude()  # keep-alive: shorter than the firmware's command timeout
-            sent_t = None
-            if command is not None:
-                sink.send(command)
-                sent_t = wall_clock()
-                last_send = now
-            replies = sink.poll()
-            for reply in replies:
-                controller.on_reply(reply)
+            command = link.send(sink, command, now, keepalive_ms, controller.state is not State.DONE)
             tick = Tick(
-                ticks, now, frame, det, controller.state, command, tuple(replies), frame_wall, sent_t,
-                laser_on=controller.laser_on,
+                ticks, now, frame, det, controller.state, command, tuple(replies), frame_wall,
+                wall_clock() if command is not None else None,
+                laser_on=controller.laser_on, drone=controller.drone.describe(), armed=controller.drone.armed,
             )
             for w in watchers:
                 w.on_tick(tick)
@@ -212,6 +216,8 @@ def run(
             pacer.wait_tick()
     except FrameSourceError as exc:
         reason, error = f"camera lost: {exc}", exc
+    except PortLost as exc:
+        reason, error = f"serial port lost: {exc}", exc
     except StopRequested as exc:
         reason, error = f"stop requested ({exc})", exc
     except KeyboardInterrupt as exc:
@@ -219,52 +225,98 @@ def run(
     except BaseException as exc:  # any stage: land safely first, report afterwards
         reason, error = f"{type(exc).__name__}: {exc}", exc
     result = RunResult(reason, ticks, controller.state, controller.fired, error)
-    landed = controller.state is State.DONE and error is None and controller.last_command == dp.disarm()
-    if not landed:
+    if isinstance(error, PortLost):
+        result.port_lost = _port_lost_line(error, link, pacer.now())
+    elif controller.state is not State.DONE or not controller.drone.safe:
         controller.abort(reason)
-        _shutdown(controller, sink, pacer, keepalive_ms, result)
-    else:
-        _finish_disarm(sink, pacer, keepalive_ms, result)
+        _shutdown(controller, sink, pacer, keepalive_ms, link, result)
     result.state = controller.state
+    result.confirmed = controller.drone.describe()
+    result.safe = controller.drone.safe
     return result
+
+
+class _LinkState:
+    """When the last frame went out (the keep-alive and the failsafe countdown start there)."""
+
+    def __init__(self, now: float) -> None:
+        self.last_send = -math.inf
+        self.last_ok = now
+
+    def send(self, sink: Sink, command: bytes | None, now: float, keepalive_ms: int, alive: bool) -> bytes | None:
+        if command is None and alive and (now - self.last_send) * 1000.0 >= keepalive_ms:
+            command = dp.hold_altitude()  # keep-alive: shorter than the firmware's command timeout
+        if command is not None:
+            self.last_send = now
+            if sink.send(command):
+                self.last_ok = now
+        return command
+
+
+def _poll(sink: Sink, controller: Controller) -> list[dp.Reply]:
+    replies = sink.poll()
+    for reply in replies:
+        controller.on_reply(reply)
+    return replies
+
+
+def _port_lost_line(error: PortLost, link: _LinkState, now: float) -> str:
+    silent_ms = max(0, round((now - link.last_ok) * 1000.0))
+    left = dp.FAILSAFE_TIMEOUT_MS - silent_ms
+    when = f"will failsafe in {left} ms" if left > 0 else f"has failsafed ({silent_ms} ms without a frame)"
+    return (
+        f"{error}; nothing more can be sent: the drone {when} (failsafe after {dp.FAILSAFE_TIMEOUT_MS} ms "
+        "without a valid frame: failsafe throttle, laser off); no landing was sent"
+    )
+
+
+def _shutdown(
+    controller: Controller, sink: Sink, pacer: Pacer, keepalive_ms: int, link: _LinkState, result: RunResult
+) -> None:
+    """Land: one frame per tick until the controller is DONE. A second interrupt cuts it to the shortest
+    safe sequence; a third stops sending; a lost port stops at once."""
+    interrupts = 0
+    stuck = 0
+    while controller.state is not State.DONE:
+        try:
+            before = pacer.now()
+            _guarded(result, "poll", lambda: _poll(sink, controller))
+            frame = controller.update(None)
+            sent = link.send(sink, frame, pacer.now(), keepalive_ms, True)
+            if sent is not None:
+                result.safe_frames.append(sent)
+            pacer.wait_tick()
+            stuck = stuck + 1 if pacer.now() <= before else 0
+            if stuck > 3:  # a pacer that cannot move on: stop rather than spin
+                result.shutdown_errors.append("the clock stopped while landing")
+                break
+        except PortLost as exc:
+            result.port_lost = _port_lost_line(exc, link, pacer.now())
+            break
+        except KeyboardInterrupt:
+            interrupts += 1
+            if interrupts > 1:
+                left = max(0, dp.FAILSAFE_TIMEOUT_MS - round((pacer.now() - link.last_ok) * 1000.0))
+                result.shutdown_errors.append(
+                    f"interrupted a third time: stopped sending; the drone will failsafe in {left} ms"
+                )
+                break
+            controller.emergency()
+            result.shutdown_errors.append(
+                "interrupted again while landing: the shortest safe sequence (laser off, land, until the drone "
+                "confirms it disarmed or stops answering)"
+            )
+        except Exception as exc:  # the shutdown must go on whatever fails
+            result.shutdown_errors.append(f"{type(exc).__name__}: {exc}")
+            stuck += 1
+            if stuck > 3:
+                break
 
 
 def _guarded(result: RunResult, what: str, fn: Callable[[], object]) -> None:
     try:
         fn()
+    except PortLost:
+        raise
     except Exception as exc:  # the shutdown must go on whatever fails
         result.shutdown_errors.append(f"{what}: {type(exc).__name__}: {exc}")
-
-
-def _shutdown(controller: Controller, sink: Sink, pacer: Pacer, keepalive_ms: int, result: RunResult) -> None:
-    def sender(frame: bytes) -> Callable[[], object]:
-        return lambda: sink.send(frame)
-
-    try:
-        for frame in controller.safe_steps():
-            result.safe_frames.append(frame)
-            _guarded(result, f"send {frame!r}", sender(frame))
-            _guarded(result, "poll", sink.poll)
-            _guarded(result, "pace", pacer.wait_tick)
-        _finish_disarm(sink, pacer, keepalive_ms, result)
-    except KeyboardInterrupt:
-        # a second Ctrl-C (or SIGTERM) while landing: laser and sticks are already safe; disarm now and go
-        if not result.safe_frames or result.safe_frames[-1] != dp.disarm():
-            result.safe_frames.append(dp.disarm())
-            _guarded(result, "send disarm", lambda: sink.send(dp.disarm()))
-        result.shutdown_errors.append("interrupted again while landing: disarmed at once")
-
-
-def _finish_disarm(sink: Sink, pacer: Pacer, keepalive_ms: int, result: RunResult) -> None:
-    """Keep the link alive while the firmware's disarm sequence runs (it refuses them as busy)."""
-    start = pacer.now()
-    last = -math.inf
-    while (pacer.now() - start) * 1000.0 < dp.ARMING_HOLD_MS + keepalive_ms:
-        if (pacer.now() - last) * 1000.0 >= keepalive_ms:
-            last = pacer.now()
-            _guarded(result, "keep-alive", lambda: sink.send(dp.hold_altitude()))
-        _guarded(result, "poll", sink.poll)
-        before = pacer.now()
-        _guarded(result, "pace", pacer.wait_tick)
-        if pacer.now() <= before:  # a pacer that cannot move on: stop rather than spin
-            break

@@ -19,6 +19,7 @@ import cv2
 import numpy as np
 import vision_eval as ve
 import vision_imagery as vi
+import vision_sequences as vs
 
 from pilot.aruco import ArucoMarkerDetector
 from pilot.config import ControllerConfig
@@ -116,12 +117,40 @@ def main(argv: list[str] | None = None) -> int:
                 "", f"## HSV on the {name}: false detections", "", *false_table(hsv_rec, threshold),
                 "", f"## ArUco on the {name}", "", *target_table(aruco_rec, 0.5, 0),
                 "", *false_table(aruco_rec, 0.5)]
+    out += gate_sweep(n)
     out += ["", "## Detection time per frame (median)", "", *timing(100 if args.quick else 1000), ""]
     text = "\n".join(out)
     print(text)
     if not args.no_write:
         (HERE / "RESULTS.md").write_text(text, encoding="utf-8")
     return 0
+
+
+def gate_sweep(n: int) -> list[str]:
+    """The gate's threshold and N on frame sequences: chosen on the tuning photos, then held-out at that pair."""
+    cfg = ControllerConfig()
+    per, empty, distr = n // 5, n, n // 5
+    out = ["", f"## The gate on sequences (HSV, whole pipeline): {per} target sequences per condition "
+           f"({vs.TARGET_FRAMES} frames, ball 32-120 px near the centre), {empty} empty and {distr} per distractor "
+           f"kind ({vs.NEGATIVE_FRAMES} frames, centring and range lifted)", "",
+           "Tuning photos. Confirmed: target sequences confirmed on the ball within K frames (worst condition but "
+           "occlusion / occlusion); negatives confirmed at all.", "",
+           "| threshold | N | targets confirmed (worst / occluded) | empty sequences | distractor sequences |",
+           "|---|---|---|---|---|"]
+    tuning = vs.sequences(vi.TUNING, 3, per, empty, distr)
+    for thr in (0.4, 0.5, 0.6, 0.7):
+        for k in (1, 2, 3, 5):
+            share, e, d = vs.rates(tuning, thr, k)
+            worst = min(v for g, v in share.items() if g != "occlusion")
+            out.append(f"| {thr} | {k} | {pct(worst)} / {pct(share['occlusion'])} | {pct(e)} | {pct(d)} |")
+    held = vs.sequences(vi.HELD_OUT, 4, per, empty, distr)
+    out += ["", f"Configured pair (threshold {cfg.acquire_confidence}, N {cfg.confirm_frames}), per condition:", "",
+            "| photos | " + " | ".join(vs.SEQ_CONDITIONS) + " | empty | distractors |",
+            "|---" * (len(vs.SEQ_CONDITIONS) + 3) + "|"]
+    for name, seqs in (("tuning", tuning), ("held-out", held)):
+        share, e, d = vs.rates(seqs, cfg.acquire_confidence, cfg.confirm_frames)
+        out.append(f"| {name} | " + " | ".join(pct(share[c]) for c in vs.SEQ_CONDITIONS) + f" | {pct(e)} | {pct(d)} |")
+    return out
 
 
 def _small(records: list[ve.Record], threshold: float) -> float:

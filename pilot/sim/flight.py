@@ -52,6 +52,7 @@ class FlightResult:
     final_armed: bool  # the firmware's state
     final_fc_armed: bool  # the flight controller's (the model's, from the sticks)
     final_altitude: float
+    confirmed: str = ""  # what the drone's last status reply said (state, laser)
     record_dir: str | None = None
     path_picture: str | None = None
     video: str | None = None
@@ -64,6 +65,7 @@ class FlightResult:
             f"lit {self.lit_on_target_ms:5d} ms "
             f"min dist {self.min_distance:4.2f} m walls {self.wall_hits} crashes {self.crashes} "
             f"sim {self.sim_seconds:5.1f} s wall {self.wall_seconds:5.2f} s ({self.reason})"
+            + ("" if self.confirmed in self.reason else f"; drone confirmed {self.confirmed}")
         )
 
 
@@ -190,6 +192,7 @@ def fly(
                 final_armed=world.outputs.armed,
                 final_fc_armed=state.armed,
                 final_altitude=state.z,
+                confirmed=result.confirmed,
                 record_dir=str(recorder.dir) if recorder is not None else None,
                 path_picture=picture,
                 video=str(recorder.video_path) if recorder is not None else None,

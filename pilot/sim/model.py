@@ -44,17 +44,17 @@ class StickCentres:
 
     @staticmethod
     def from_protocol() -> StickCentres:
-        import drone_protocol
+        import drone_protocol as dp
 
-        ch = drone_protocol.CHANNELS
+        ch = dp.CHANNELS
         return StickCentres(
-            roll=int(ch["roll"].median),
-            pitch=int(ch["pitch"].median),
-            throttle=int(ch["throttle"].median),
-            yaw=int(ch["yaw"].median),
-            throttle_minimum=int(ch["throttle"].minimum),
-            yaw_minimum=int(ch["yaw"].minimum),
-            yaw_maximum=int(ch["yaw"].maximum),
+            roll=int(ch[dp.ChannelName.ROLL].median),
+            pitch=int(ch[dp.ChannelName.PITCH].median),
+            throttle=int(ch[dp.ChannelName.THROTTLE].median),
+            yaw=int(ch[dp.ChannelName.YAW].median),
+            throttle_minimum=int(ch[dp.ChannelName.THROTTLE].minimum),
+            yaw_minimum=int(ch[dp.ChannelName.YAW].minimum),
+            yaw_maximum=int(ch[dp.ChannelName.YAW].maximum),
         )
 
 

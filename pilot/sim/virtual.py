@@ -13,7 +13,7 @@ from __future__ import annotations
 import json
 import os
 import subprocess
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import IO, Any
 
@@ -21,6 +21,7 @@ from ..closing import Closing
 from ..errors import SimulatorError
 from .model import Outputs
 
+_TYPES: dict[Any, Any] = {"int": int, "float": float, "bool": bool, int: int, float: float, bool: bool}
 REPO = Path(__file__).resolve().parents[2]
 DEFAULT_EXE = REPO / "firmware" / "build" / "host" / "virtual_drone"
 ENV_VAR = "PILOT_VIRTUAL_DRONE"
@@ -45,20 +46,12 @@ class Change:
 
 
 def _outputs(d: dict[str, Any]) -> Outputs:
+    """The output line's fields are named as Outputs' fields (the pins the firmware drives)."""
     try:
-        return Outputs(
-            roll=int(d["roll"]),
-            pitch=int(d["pitch"]),
-            throttle=int(d["throttle"]),
-            yaw=int(d["yaw"]),
-            mode=int(d["mode"]),
-            pan=float(d["pan"]),
-            tilt=float(d["tilt"]),
-            laser=bool(d["laser"]),
-            armed=bool(d["armed"]),
-        )
+        values = {f.name: _TYPES[f.type](d[f.name]) for f in fields(Outputs)}
     except (KeyError, TypeError, ValueError) as exc:
         raise SimulatorError(f"virtual drone: unexpected output line {d!r} ({exc})") from exc
+    return Outputs(**values)
 
 
 class VirtualDrone(Closing):

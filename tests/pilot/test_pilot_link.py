@@ -15,7 +15,7 @@ import drone_protocol as dp
 import pytest
 import serial
 
-from pilot.errors import FingerprintMismatch, LinkError, ReadyTimeout
+from pilot.errors import FingerprintMismatch, LinkError, PortLost, ReadyTimeout
 from pilot.link import Link, LogEntry, keepalive_ms
 
 FRAMES = [
@@ -247,9 +247,13 @@ def test_reconnect_gives_up_after_its_time_with_a_clear_error() -> None:
     link._ready_clock = clock  # reconnect attempts on the injected clock from here on
     link._ready_sleep = clock.sleep
     server.close()  # gone for good
-    with pytest.raises(LinkError, match=r"not back within 1\.0 s"):
+    with pytest.raises(PortLost, match=r"not back within 1\.0 s"):
         for _ in range(100):
             link.poll()
             link.send(dp.hold_altitude())
             time.sleep(0.01)
+    # nothing more can reach the drone: every later send says so at once (never an AttributeError on None)
+    with pytest.raises(PortLost, match="is gone"):
+        link.send(dp.land())
+    assert link.poll() == []
     link.close()
