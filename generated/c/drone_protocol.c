@@ -98,8 +98,6 @@ dp_error dp_encode(dp_command_id id, uint16_t value, uint8_t out[DP_WIRE_LENGTH]
   return DP_ERROR_NONE;
 }
 
-static dp_error finish_value(const uint8_t *frame, int8_t index, dp_command *out);
-
 /* Is byte `pos` of `frame` valid, given that the bytes before it are? At byte 1, sets `*index`. */
 static dp_error check_byte(const uint8_t *frame, uint8_t pos, int8_t *index) {
   if (pos == 0) return dp_is_category(frame[0]) ? DP_ERROR_NONE : DP_ERROR_BAD_CATEGORY;
@@ -107,12 +105,11 @@ static dp_error check_byte(const uint8_t *frame, uint8_t pos, int8_t *index) {
     *index = (int8_t)dp_find_command(frame[0], frame[1]);
     return *index >= 0 ? DP_ERROR_NONE : DP_ERROR_BAD_DIRECTION;
   }
-  if ((uint8_t)(frame[pos] - '0') > 9u) return DP_ERROR_BAD_DIGIT;
-  return DP_ERROR_NONE;
+  return (uint8_t)(frame[pos] - '0') <= 9u ? DP_ERROR_NONE : DP_ERROR_BAD_DIGIT;
 }
 
-/* The value and range check of a frame whose bytes are all valid; `index` is its command's. */
-static dp_error finish_value(const uint8_t *frame, int8_t index, dp_command *out) {
+/* The value of a complete wire frame whose bytes are all valid, checked against the range of its command `index`. */
+static dp_error finish(const uint8_t *frame, int8_t index, dp_command *out) {
   uint16_t value = 0;
   uint8_t i;
   for (i = 2; i < DP_FRAME_LENGTH; ++i) value = (uint16_t)(value * 10u + (uint8_t)(frame[i] - '0'));
@@ -122,11 +119,6 @@ static dp_error finish_value(const uint8_t *frame, int8_t index, dp_command *out
   out->direction = frame[1];
   out->value = value;
   return DP_ERROR_NONE;
-}
-
-/* A frame whose bytes are all valid: its value. */
-static dp_error finish(const uint8_t *frame, int8_t index, dp_command *out) {
-  return finish_value(frame, index, out);
 }
 
 dp_error dp_decode(const uint8_t *frame, size_t length, dp_command *out) {

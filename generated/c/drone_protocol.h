@@ -365,7 +365,7 @@ static inline bool dp_stream_feed(dp_stream_parser *parser, uint8_t byte, uint32
   parser->last_ms = now_ms;
   if (parser->length >= 2) {
     if (parser->length < DP_FRAME_LENGTH - 1 && (uint8_t)(byte - '0') <= 9u) {
-      parser->buffer[parser->length++] = byte; /* a middle digit */
+      parser->buffer[parser->length++] = byte; /* a digit that does not complete the frame */
       return false;
     }
   } else if (parser->length == 1) {

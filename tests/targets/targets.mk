@@ -1,7 +1,8 @@
 # The Rust crate (generated/rust) and the C99 codec (generated/c): native tests, linters, bare-metal builds and a
 # libFuzzer smoke run. Included by the top Makefile; `make targets-test` is part of `make test`.
 #
-#   make rust-test       cargo test (vectors.json, replies, seeded random streams, README doctest), clippy -D warnings,
+#   make rust-test       cargo fmt --check (the generated code is rustfmt's output), cargo test (vectors.json, replies,
+#                        seeded random streams, README doctest), clippy -D warnings,
 #                        a bare-metal build (thumbv7em-none-eabihf through rustup; a host no_std build if refused),
 #                        cargo package
 #   make c-test          the codec with gcc and clang (-std=c99 -pedantic -Werror), for the ATmega328P with avr-gcc,
@@ -29,6 +30,8 @@ cargo-available:
 	@command -v cargo >/dev/null || { echo "cargo is missing: install Rust with rustup (https://rustup.rs)"; exit 1; }
 
 rust-test: cargo-available
+	@cargo fmt --version >/dev/null 2>&1 || rustup component add rustfmt
+	$(CARGO_RUN) fmt --check
 	$(CARGO_RUN) test $(CARGO_FLAGS) --quiet
 	$(CARGO_RUN) clippy $(CARGO_FLAGS) --all-targets --quiet -- -D warnings
 	@if rustup target list --installed 2>/dev/null | grep -qx $(RUST_BARE_METAL) || rustup target add $(RUST_BARE_METAL); then \
@@ -39,7 +42,7 @@ rust-test: cargo-available
 	  $(CARGO_RUN) build $(CARGO_FLAGS) --release --quiet; \
 	fi
 	$(CARGO_RUN) package $(CARGO_FLAGS) --allow-dirty --no-verify --quiet
-	@echo "rust: tests, clippy, bare-metal build and package OK"
+	@echo "rust: rustfmt, tests, clippy, bare-metal build and package OK"
 
 $(TARGETS_BUILD)/test_c_codec: tests/targets/c/test_c_codec.c tests/targets/c/reference.h $(C_SOURCES) $(C_DIR)/*.h
 	@mkdir -p $(@D)

@@ -17,6 +17,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 GENERATED = ROOT / "generated"
 DRIVERS = Path(__file__).resolve().parent / "drivers"
+TYPESCRIPT_DRIVER = Path(__file__).resolve().parent / "typescript" / "stream_driver.mjs"
 BUILD = ROOT / "build" / "targets"
 CARGO_TARGET = ROOT / "build" / "rust" / "target"
 CRATE = GENERATED / "rust"
@@ -102,12 +103,30 @@ def python_driver() -> list[str]:
     return [sys.executable, str(DRIVERS / "stream_driver.py")]
 
 
+@functools.cache
+def typescript_driver() -> list[str]:
+    """The TypeScript package packed as a user gets it (`make typescript`: pinned tsc, build/typescript)."""
+    run(["make", "--no-print-directory", "--quiet", "typescript"])
+    return typescript_driver_of(ROOT / "build" / "typescript" / "package" / "dist")
+
+
+def typescript_driver_of(dist: Path) -> list[str]:
+    return ["node", str(TYPESCRIPT_DRIVER), str(dist)]
+
+
+def tsc() -> Path:
+    """The repository's pinned TypeScript compiler (installed by `make typescript`)."""
+    typescript_driver()
+    return TYPESCRIPT_DRIVER.parent / "node_modules" / ".bin" / "tsc"
+
+
 # Every language's stream driver. Adding a language is one line here.
 STREAM_DRIVERS: dict[str, Callable[[], list[str]]] = {
     "python": python_driver,
     "cpp": lambda: [str(cpp_driver())],
     "c": lambda: [str(c_driver())],
     "rust": lambda: [str(rust_driver())],
+    "typescript": typescript_driver,
 }
 
 

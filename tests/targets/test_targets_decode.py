@@ -17,6 +17,7 @@ SAMPLE_SIZE = 100_000
 def drivers() -> dict[str, list[str]]:
     """Every language's decode driver; the first is the reference."""
     c = t.BUILD / "decode_driver_c"
+    t.BUILD.mkdir(parents=True, exist_ok=True)
     t.run(["gcc", *t.CFLAGS, f"-I{t.C_DIR}", str(t.DRIVERS / "decode_driver.c"), *map(str, t.c_sources()),
            "-o", str(c)])
     return {"python": [sys.executable, str(t.DRIVERS / "decode_driver.py")], "c": [str(c)],

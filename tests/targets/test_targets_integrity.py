@@ -1,5 +1,6 @@
 """The Rust and C targets generated from the spec in crc8 integrity mode: their own test suites pass (wire frames
-carry the check, a wrong check is bad_check, reply lines end in *XX), and their stream parsers agree."""
+carry the check, a wrong check is bad_check, reply lines end in *XX), and their stream parsers agree with each
+other, with Python's and with TypeScript's."""
 
 from __future__ import annotations
 
@@ -35,9 +36,10 @@ def c_driver(tree: Path) -> Path:
     return out
 
 
-def test_the_crc8_crate_passes_its_tests_and_clippy() -> None:
+def test_the_crc8_crate_passes_rustfmt_its_tests_and_clippy() -> None:
     crate = crc8_tree() / "rust"
     env = {"CARGO_TARGET_DIR": str(BUILD / "target")}
+    t.run(["cargo", "fmt", "--check"], cwd=crate)
     t.run(["cargo", "test", "--locked", "--offline", "--quiet"], cwd=crate, env=env)
     t.run(["cargo", "clippy", "--locked", "--offline", "--all-targets", "--quiet", "--", "-D", "warnings"], cwd=crate,
           env=env)
@@ -76,6 +78,9 @@ def crc8_outputs(language: str) -> list[str]:
         return proc.stdout.splitlines()
     if language == "c":
         return _run(c_driver(tree), crc8_stream())
+    if language == "typescript":
+        t.run([str(t.tsc()), "-p", str(tree / "typescript" / "tsconfig.json")])
+        return _run_cmd(t.typescript_driver_of(tree / "typescript" / "dist"), crc8_stream())
     t.run(["cargo", "build", "--release", "--locked", "--offline", "--quiet"], cwd=tree / "rust",
           env={"CARGO_TARGET_DIR": str(BUILD / "target")})
     rlib = BUILD / "target" / "release" / "libdrone_protocol.rlib"
@@ -91,10 +96,15 @@ def test_the_crc8_rust_and_c_stream_parsers_agree_on_checked_frames_and_garbage(
     assert errors["bad_check"] > 100 and errors["out_of_range"] > 100 and len(crc8_outputs("c")) > 1000, errors
 
 
-def test_the_crc8_python_stream_decoder_agrees_with_rust_and_c() -> None:
+def test_the_crc8_python_and_typescript_stream_decoders_agree_with_rust_and_c() -> None:
     assert crc8_outputs("python") == crc8_outputs("c")
+    assert crc8_outputs("typescript") == crc8_outputs("c")
 
 
 def _run(exe: Path, stdin: str) -> list[str]:
-    proc = subprocess.run([str(exe)], input=stdin, capture_output=True, text=True, timeout=120, check=True)
+    return _run_cmd([str(exe)], stdin)
+
+
+def _run_cmd(cmd: list[str], stdin: str) -> list[str]:
+    proc = subprocess.run(cmd, input=stdin, capture_output=True, text=True, timeout=120, check=True)
     return proc.stdout.splitlines()

@@ -300,7 +300,21 @@ pub enum Error {
 
 impl Error {
     /// Every kind, in spec order.
-    pub const ALL: [Error; 13] = [Error::BadCategory, Error::BadDirection, Error::BadDigit, Error::OutOfRange, Error::Timeout, Error::TooShort, Error::TooLong, Error::NotArmed, Error::Busy, Error::Unsupported, Error::Armed, Error::Airborne, Error::BadCheck];
+    pub const ALL: [Error; 13] = [
+        Error::BadCategory,
+        Error::BadDirection,
+        Error::BadDigit,
+        Error::OutOfRange,
+        Error::Timeout,
+        Error::TooShort,
+        Error::TooLong,
+        Error::NotArmed,
+        Error::Busy,
+        Error::Unsupported,
+        Error::Armed,
+        Error::Airborne,
+        Error::BadCheck,
+    ];
 
     /// The code letter of the reply that reports it.
     pub const fn code(self) -> u8 {
@@ -438,32 +452,243 @@ pub struct CommandInfo {
 
 /// Every command's [`CommandInfo`], indexed by [`CommandId`].
 pub const COMMANDS: [CommandInfo; 21] = [
-    CommandInfo { name: "move_forward", category: Category::Move, direction: b'f', min: 1000, max: 2000, default: Some(1600), target: Target::Pitch, sense: 0 },
-    CommandInfo { name: "move_backward", category: Category::Move, direction: b'b', min: 1000, max: 2000, default: Some(1400), target: Target::Pitch, sense: 0 },
-    CommandInfo { name: "move_left", category: Category::Move, direction: b'l', min: 1000, max: 2000, default: Some(1400), target: Target::Roll, sense: 0 },
-    CommandInfo { name: "move_right", category: Category::Move, direction: b'r', min: 1000, max: 2000, default: Some(1600), target: Target::Roll, sense: 0 },
-    CommandInfo { name: "move_up", category: Category::Move, direction: b'u', min: 1029, max: 2012, default: Some(1621), target: Target::Throttle, sense: 0 },
-    CommandInfo { name: "move_down", category: Category::Move, direction: b'd', min: 1029, max: 2012, default: Some(1421), target: Target::Throttle, sense: 0 },
-    CommandInfo { name: "turn_left", category: Category::Turn, direction: b'l', min: 1035, max: 2012, default: Some(1424), target: Target::Yaw, sense: 0 },
-    CommandInfo { name: "turn_right", category: Category::Turn, direction: b'r', min: 1035, max: 2012, default: Some(1624), target: Target::Yaw, sense: 0 },
-    CommandInfo { name: "servo_up", category: Category::Servo, direction: b'u', min: 1, max: 180, default: None, target: Target::Tilt, sense: 1 },
-    CommandInfo { name: "servo_down", category: Category::Servo, direction: b'd', min: 1, max: 180, default: None, target: Target::Tilt, sense: -1 },
-    CommandInfo { name: "servo_left", category: Category::Servo, direction: b'l', min: 1, max: 180, default: None, target: Target::Pan, sense: -1 },
-    CommandInfo { name: "servo_right", category: Category::Servo, direction: b'r', min: 1, max: 180, default: None, target: Target::Pan, sense: 1 },
-    CommandInfo { name: "servo_reset", category: Category::Servo, direction: b'x', min: 0, max: 0, default: Some(0), target: Target::Both, sense: 0 },
-    CommandInfo { name: "laser_toggle", category: Category::Laser, direction: b'0', min: 0, max: 0, default: Some(0), target: Target::None, sense: 0 },
-    CommandInfo { name: "laser_on", category: Category::Laser, direction: b'n', min: 0, max: 0, default: Some(0), target: Target::None, sense: 0 },
-    CommandInfo { name: "laser_off", category: Category::Laser, direction: b'f', min: 0, max: 0, default: Some(0), target: Target::None, sense: 0 },
-    CommandInfo { name: "arm", category: Category::Init, direction: b'a', min: 0, max: 0, default: Some(0), target: Target::None, sense: 0 },
-    CommandInfo { name: "disarm", category: Category::Init, direction: b'k', min: 0, max: 0, default: Some(0), target: Target::None, sense: 0 },
-    CommandInfo { name: "hold_altitude", category: Category::Init, direction: b's', min: 0, max: 0, default: Some(0), target: Target::None, sense: 0 },
-    CommandInfo { name: "first_test", category: Category::Init, direction: b't', min: 0, max: 0, default: Some(0), target: Target::None, sense: 0 },
-    CommandInfo { name: "land", category: Category::Init, direction: b'l', min: 0, max: 0, default: Some(0), target: Target::None, sense: 0 },
+    CommandInfo {
+        name: "move_forward",
+        category: Category::Move,
+        direction: b'f',
+        min: 1000,
+        max: 2000,
+        default: Some(1600),
+        target: Target::Pitch,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "move_backward",
+        category: Category::Move,
+        direction: b'b',
+        min: 1000,
+        max: 2000,
+        default: Some(1400),
+        target: Target::Pitch,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "move_left",
+        category: Category::Move,
+        direction: b'l',
+        min: 1000,
+        max: 2000,
+        default: Some(1400),
+        target: Target::Roll,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "move_right",
+        category: Category::Move,
+        direction: b'r',
+        min: 1000,
+        max: 2000,
+        default: Some(1600),
+        target: Target::Roll,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "move_up",
+        category: Category::Move,
+        direction: b'u',
+        min: 1029,
+        max: 2012,
+        default: Some(1621),
+        target: Target::Throttle,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "move_down",
+        category: Category::Move,
+        direction: b'd',
+        min: 1029,
+        max: 2012,
+        default: Some(1421),
+        target: Target::Throttle,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "turn_left",
+        category: Category::Turn,
+        direction: b'l',
+        min: 1035,
+        max: 2012,
+        default: Some(1424),
+        target: Target::Yaw,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "turn_right",
+        category: Category::Turn,
+        direction: b'r',
+        min: 1035,
+        max: 2012,
+        default: Some(1624),
+        target: Target::Yaw,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "servo_up",
+        category: Category::Servo,
+        direction: b'u',
+        min: 1,
+        max: 180,
+        default: None,
+        target: Target::Tilt,
+        sense: 1,
+    },
+    CommandInfo {
+        name: "servo_down",
+        category: Category::Servo,
+        direction: b'd',
+        min: 1,
+        max: 180,
+        default: None,
+        target: Target::Tilt,
+        sense: -1,
+    },
+    CommandInfo {
+        name: "servo_left",
+        category: Category::Servo,
+        direction: b'l',
+        min: 1,
+        max: 180,
+        default: None,
+        target: Target::Pan,
+        sense: -1,
+    },
+    CommandInfo {
+        name: "servo_right",
+        category: Category::Servo,
+        direction: b'r',
+        min: 1,
+        max: 180,
+        default: None,
+        target: Target::Pan,
+        sense: 1,
+    },
+    CommandInfo {
+        name: "servo_reset",
+        category: Category::Servo,
+        direction: b'x',
+        min: 0,
+        max: 0,
+        default: Some(0),
+        target: Target::Both,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "laser_toggle",
+        category: Category::Laser,
+        direction: b'0',
+        min: 0,
+        max: 0,
+        default: Some(0),
+        target: Target::None,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "laser_on",
+        category: Category::Laser,
+        direction: b'n',
+        min: 0,
+        max: 0,
+        default: Some(0),
+        target: Target::None,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "laser_off",
+        category: Category::Laser,
+        direction: b'f',
+        min: 0,
+        max: 0,
+        default: Some(0),
+        target: Target::None,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "arm",
+        category: Category::Init,
+        direction: b'a',
+        min: 0,
+        max: 0,
+        default: Some(0),
+        target: Target::None,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "disarm",
+        category: Category::Init,
+        direction: b'k',
+        min: 0,
+        max: 0,
+        default: Some(0),
+        target: Target::None,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "hold_altitude",
+        category: Category::Init,
+        direction: b's',
+        min: 0,
+        max: 0,
+        default: Some(0),
+        target: Target::None,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "first_test",
+        category: Category::Init,
+        direction: b't',
+        min: 0,
+        max: 0,
+        default: Some(0),
+        target: Target::None,
+        sense: 0,
+    },
+    CommandInfo {
+        name: "land",
+        category: Category::Init,
+        direction: b'l',
+        min: 0,
+        max: 0,
+        default: Some(0),
+        target: Target::None,
+        sense: 0,
+    },
 ];
 
 impl CommandId {
     /// Every command, in spec order.
-    pub const ALL: [CommandId; 21] = [CommandId::MoveForward, CommandId::MoveBackward, CommandId::MoveLeft, CommandId::MoveRight, CommandId::MoveUp, CommandId::MoveDown, CommandId::TurnLeft, CommandId::TurnRight, CommandId::ServoUp, CommandId::ServoDown, CommandId::ServoLeft, CommandId::ServoRight, CommandId::ServoReset, CommandId::LaserToggle, CommandId::LaserOn, CommandId::LaserOff, CommandId::Arm, CommandId::Disarm, CommandId::HoldAltitude, CommandId::FirstTest, CommandId::Land];
+    pub const ALL: [CommandId; 21] = [
+        CommandId::MoveForward,
+        CommandId::MoveBackward,
+        CommandId::MoveLeft,
+        CommandId::MoveRight,
+        CommandId::MoveUp,
+        CommandId::MoveDown,
+        CommandId::TurnLeft,
+        CommandId::TurnRight,
+        CommandId::ServoUp,
+        CommandId::ServoDown,
+        CommandId::ServoLeft,
+        CommandId::ServoRight,
+        CommandId::ServoReset,
+        CommandId::LaserToggle,
+        CommandId::LaserOn,
+        CommandId::LaserOff,
+        CommandId::Arm,
+        CommandId::Disarm,
+        CommandId::HoldAltitude,
+        CommandId::FirstTest,
+        CommandId::Land,
+    ];
 
     /// What the spec says of it.
     #[inline]
@@ -571,20 +796,14 @@ pub(crate) fn check_byte(frame: &Frame, pos: usize, id: &mut Option<CommandId>) 
                 None => Err(Error::BadDirection),
             }
         }
-        _ if pos < FRAME_LENGTH && frame[pos].is_ascii_digit() => Ok(()),
+        _ if frame[pos].is_ascii_digit() => Ok(()),
         _ => Err(Error::BadDigit),
     }
 }
 
-/// The value and range check of a frame whose bytes are all valid.
+/// The value of a complete wire frame whose bytes are all valid, checked against its command's range.
 #[inline]
 pub(crate) fn finish(frame: &Frame, id: CommandId) -> Result<Command, Error> {
-    finish_value(frame, id)
-}
-
-/// The value of a frame whose command bytes are all valid, checked against its command's range.
-#[inline]
-fn finish_value(frame: &Frame, id: CommandId) -> Result<Command, Error> {
     let mut value: u16 = 0;
     for &digit in &frame[2..FRAME_LENGTH] {
         value = value * 10 + u16::from(digit - b'0');

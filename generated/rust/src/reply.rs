@@ -42,7 +42,17 @@ pub enum State {
 
 impl State {
     /// Every state, in spec order.
-    pub const ALL: [State; 9] = [State::Disarmed, State::Arming, State::Armed, State::HoldAltitude, State::Moving, State::Landing, State::Disarming, State::SelfTest, State::Failsafe];
+    pub const ALL: [State; 9] = [
+        State::Disarmed,
+        State::Arming,
+        State::Armed,
+        State::HoldAltitude,
+        State::Moving,
+        State::Landing,
+        State::Disarming,
+        State::SelfTest,
+        State::Failsafe,
+    ];
 
     /// Its code letter in a reply.
     pub const fn code(self) -> u8 {
@@ -201,7 +211,11 @@ pub fn parse_reply(line: &[u8]) -> Result<Reply<'_>, ReplyError> {
             return Err(malformed);
         };
         let text = |word| core::str::from_utf8(word).map_err(|_| malformed);
-        return Ok(Reply::Ready { protocol: text(protocol)?, fingerprint: text(fingerprint)?, integrity: text(integrity)? });
+        return Ok(Reply::Ready {
+            protocol: text(protocol)?,
+            fingerprint: text(fingerprint)?,
+            integrity: text(integrity)?,
+        });
     }
     // The others end with the separator and the status.
     let split = rest.len().checked_sub(STATUS_SEPARATOR.len() + 2).ok_or(malformed)?;

@@ -3,15 +3,17 @@
 // Edit the spec and run `python -m generator` instead.
 //! The byte-at-a-time stream parser, with the same rules as the Arduino's C++ `StreamParser`.
 
-use crate::{check_byte, finish, Category, Command, CommandId, Error, Frame, FRAME_LENGTH, INTER_BYTE_TIMEOUT_MS, WIRE_LENGTH};
+use crate::{
+    check_byte, finish, Category, Command, CommandId, Error, Frame, FRAME_LENGTH, INTER_BYTE_TIMEOUT_MS, WIRE_LENGTH,
+};
 
-
-/// While the buffer holds fewer bytes than this, a digit is a middle digit: it completes neither the frame nor
-/// its value (the fast path).
+/// While the buffer holds fewer bytes than this, a digit needs no check beyond being a digit: it does not
+/// complete the frame (the fast path).
 const DIGITS_END: usize = FRAME_LENGTH - 1;
 
 /// The error kinds a stream parser meets and counts.
-pub const STREAM_ERRORS: [Error; 5] = [Error::BadCategory, Error::BadDirection, Error::BadDigit, Error::OutOfRange, Error::Timeout, ];
+pub const STREAM_ERRORS: [Error; 5] =
+    [Error::BadCategory, Error::BadDirection, Error::BadDigit, Error::OutOfRange, Error::Timeout];
 
 /// Finds frames in a byte stream that may hold garbage, lost bytes and pauses.
 ///

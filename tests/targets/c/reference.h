@@ -55,22 +55,19 @@ static dp_error reference_first_error(const uint8_t *buf, uint8_t len) {
   for (i = 2; i < len && i < DP_FRAME_LENGTH; ++i) {
     if (buf[i] < '0' || buf[i] > '9') return DP_ERROR_BAD_DIGIT;
   }
-  if (len >= DP_FRAME_LENGTH) { /* the range, as soon as the value is complete */
+#if DP_CHECK_LENGTH > 0
+  if (len > DP_FRAME_LENGTH) { /* each check digit as it arrives */
+    uint8_t check[2];
+    reference_check(buf, DP_FRAME_LENGTH, check);
+    if (memcmp(check, buf + DP_FRAME_LENGTH, (size_t)(len - DP_FRAME_LENGTH)) != 0) return DP_ERROR_BAD_CHECK;
+  }
+#endif
+  if (len == DP_WIRE_LENGTH) { /* the range, once the whole frame is in */
     uint32_t value = 0;
     const dp_command_info *info = dp_command_info_of((dp_command_id)reference_find(buf[0], buf[1]));
     for (i = 2; i < DP_FRAME_LENGTH; ++i) value = value * 10u + (uint32_t)(buf[i] - '0');
     if (value < info->min || value > info->max) return DP_ERROR_OUT_OF_RANGE;
   }
-#if DP_CHECK_LENGTH > 0
-  for (i = DP_FRAME_LENGTH; i < len; ++i) {
-    if (!((buf[i] >= '0' && buf[i] <= '9') || (buf[i] >= 'A' && buf[i] <= 'F'))) return DP_ERROR_BAD_CHECK;
-  }
-  if (len == DP_WIRE_LENGTH) {
-    uint8_t check[2];
-    reference_check(buf, DP_FRAME_LENGTH, check);
-    if (memcmp(check, buf + DP_FRAME_LENGTH, 2) != 0) return DP_ERROR_BAD_CHECK;
-  }
-#endif
   return DP_ERROR_NONE;
 }
 
