@@ -24,7 +24,8 @@ HOST_CXX ?= g++
 HOST_CC ?= gcc
 
 FW_SKETCH_SRC := $(FW_DIR)/drone/drone_app.cpp $(FW_DIR)/drone/drone_logic.cpp $(FW_DIR)/drone/drone_handlers.cpp \
-                 $(FW_DIR)/drone/pulse_schedule.cpp $(FW_DIR)/drone/pulse_out_avr.cpp
+                 $(FW_DIR)/drone/pulse_schedule.cpp $(FW_DIR)/drone/pulse_out_avr.cpp \
+                 $(FW_DIR)/drone/serial_avr.cpp
 FW_HEADERS := $(wildcard $(FW_DIR)/drone/*.h)
 FW_PROTO_SRC = $(wildcard $(DRONE_PROTOCOL_DIR)/src/*.cpp)
 FW_PROTO_HDR = $(wildcard $(DRONE_PROTOCOL_DIR)/src/*.h)

@@ -25,5 +25,5 @@ bench-firmware: $(VENV_STAMP) $(FW_BENCH_ELVES) $(FW_BUILD)/sim/drone_sim
 # (bench/firmware/parser/parser_bench.py); writes bench/firmware/PARSER_RESULTS.md.
 .PHONY: bench-parser
 bench-parser: $(VENV_STAMP) $(FW_BUILD)/sim/drone_sim
-	$(PY) bench/firmware/parser/parser_bench.py
+	PYTHONPATH=. $(PY) bench/firmware/parser/parser_bench.py
 bench-firmware: bench-parser

@@ -48,8 +48,8 @@ sys.path.insert(0, str(CODEC_DIR))
 import drone_protocol as dp  # noqa: E402
 
 PYTHON_TARGET = 2.0
-FLASH_TARGET = 1024
-RAM_TARGET = 32
+FLASH_TARGET = 908  # issue 11
+RAM_TARGET = 28  # issue 11
 # The firmware's flags (firmware/firmware.mk), minus the Arduino core: both sketches are built with exactly these.
 AVR_FLAGS = [
     "-mmcu=atmega328p", "-Os", "-std=gnu++11", "-DF_CPU=16000000L", "-fno-exceptions", "-fno-threadsafe-statics",
@@ -362,12 +362,12 @@ def bench_avr(settings: Settings) -> list[Row]:
     _run(["avr-g++", *AVR_FLAGS, f"-I{ARDUINO_SRC}", "-DWITH_PARSER", sketch, "-o", parser_elf])
     base, with_parser = _avr_size(base_elf), _avr_size(parser_elf)
     flash, ram = with_parser.flash - base.flash, with_parser.ram - base.ram
-    flash_ok, ram_ok = flash < FLASH_TARGET, ram < RAM_TARGET
+    flash_ok, ram_ok = flash <= FLASH_TARGET, ram <= RAM_TARGET
     return [
         Row("avr", "flash of StreamParser+dispatch (avr-g++ -Os -flto)", f"{flash} B (sketch {with_parser.flash} B)",
-            f"sketch without it {base.flash} B", "-", f"< {FLASH_TARGET} B", "met" if flash_ok else "MISSED"),
+            f"sketch without it {base.flash} B", "-", f"<= {FLASH_TARGET} B", "met" if flash_ok else "MISSED"),
         Row("avr", "static RAM of StreamParser+dispatch", f"{ram} B (sketch {with_parser.ram} B)",
-            f"sketch without it {base.ram} B", "-", f"< {RAM_TARGET} B", "met" if ram_ok else "MISSED"),
+            f"sketch without it {base.ram} B", "-", f"<= {RAM_TARGET} B", "met" if ram_ok else "MISSED"),
     ]
 
 

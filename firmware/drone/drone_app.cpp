@@ -8,6 +8,7 @@
 #include "pin_io.h"
 #include "pins.h"
 #include "pulse_out.h"
+#include "serial_link.h"
 
 #ifdef DRONE_BENCH_PARSER_PIN
 void drone_bench_parser_mark();  // called by drone_logic.cpp around the parser
@@ -30,14 +31,8 @@ static_assert(RC_MAX_SUM_US + pulse_timing::PPM_SEPARATOR_US + 2u * pulse_timing
                   pulse_timing::PPM_FRAME_US,
               "the widest PPM channels no longer leave a sync gap");
 
-bool transmit(const char* data, uint8_t length) {
-  // Never block the loop on a slow or absent reader: drop the reply instead.
-  if (Serial.availableForWrite() < static_cast<int>(length)) return false;
-  Serial.write(reinterpret_cast<const uint8_t*>(data), length);
-  return true;
-}
-
-drone::Drone the_drone(transmit);
+// Never blocks the loop on a slow or absent reader: a reply that does not fit is dropped instead.
+drone::Drone the_drone(serial_link::write);
 drone::Outputs applied;  // the outputs the pins and pulse generator were last given
 uint16_t pending_widths[pulse::OUTPUTS];
 bool widths_pending = false;  // pending_widths not yet taken by the generator
@@ -106,7 +101,7 @@ void idle() {
 #ifdef __AVR__
   set_sleep_mode(SLEEP_MODE_IDLE);
   cli();
-  if (Serial.available() == 0) {
+  if (serial_link::available() == 0) {
     sleep_enable();
     sei();
     sleep_cpu();
@@ -155,7 +150,7 @@ void setup() {
 #endif
   }
 #endif
-  Serial.begin(drone::dp::BAUD);
+  serial_link::begin();
   the_drone.begin(millis());
   applied = the_drone.outputs();
   uint16_t w[pulse::OUTPUTS];
@@ -166,13 +161,13 @@ void setup() {
 void loop() {
   const uint32_t now = millis();
 #ifdef DRONE_BENCH_PIN
-  const bool busy = Serial.available() > 0;
+  const bool busy = serial_link::available() > 0;
   if (busy) bench_mark();
 #endif
   // Bounded so timers and outputs are served even under a byte flood.
   bool framed = false;
-  for (uint8_t n = 0; n < 64 && Serial.available() > 0; ++n) {
-    framed |= the_drone.receive(static_cast<uint8_t>(Serial.read()), now);
+  for (uint8_t n = 0; n < 64 && serial_link::available() > 0; ++n) {
+    framed |= the_drone.receive(serial_link::read(), now);
   }
   // Timers only move when millis() does, outputs only after a frame or a
   // timer: a byte in the middle of a frame costs little more than the parser.

@@ -54,6 +54,8 @@ const TestStep kSelfTest[] DRONE_FLASH = {
 };
 constexpr uint8_t SELF_TEST_STEPS = sizeof(kSelfTest) / sizeof(kSelfTest[0]);
 static_assert(sizeof(kSelfTest) / sizeof(kSelfTest[0]) < 256, "steps are counted in a uint8_t");
+static_assert(static_cast<uint32_t>(SELF_TEST_STEPS) * SELF_TEST_STEP_MS <= 0xFFFFu,
+              "the state machine measures its spans in 16 bits");
 
 }  // namespace
 
@@ -63,8 +65,8 @@ bool operator==(const Outputs& a, const Outputs& b) {
 }
 
 void Drone::begin(uint32_t now_ms) {
-  now_ms_ = now_ms;
-  last_frame_ms_ = now_ms;
+  now_ms_ = static_cast<uint16_t>(now_ms);
+  last_frame_ms_ = static_cast<uint16_t>(now_ms);
   parser_.reset();
   out_.mode = dp::MODE_STABILIZE_US;
   out_.pan = dp::SERVO_PAN_DEFAULT;
@@ -81,7 +83,7 @@ void Drone::reply(const char* line, uint8_t length) {
 }
 
 bool Drone::receive(uint8_t byte, uint32_t now_ms) {
-  now_ms_ = now_ms;
+  now_ms_ = static_cast<uint16_t>(now_ms);
   char line[dp::REPLY_MAX_LENGTH];
   DRONE_PARSER_MARK();
   const bool complete = parser_.feed(byte, now_ms);
@@ -102,7 +104,7 @@ bool Drone::receive(uint8_t byte, uint32_t now_ms) {
 
 void Drone::execute(const dp::Command& c, uint32_t now_ms) {
   // Any well-formed frame proves the link is alive, even one refused below.
-  last_frame_ms_ = now_ms;
+  last_frame_ms_ = static_cast<uint16_t>(now_ms);
   // The failsafe disarmed the drone: a new arming sequence is needed.
   if (state_ == State::Failsafe) enter(State::Disarmed);
   result_ = dp::Error::None;
@@ -238,9 +240,9 @@ void Drone::self_test_step(uint8_t step) {
 }
 
 void Drone::update(uint32_t now_ms) {
-  now_ms_ = now_ms;
-  const uint32_t in_state = now_ms - state_since_ms_;
-  if (state_ != State::Failsafe && now_ms - last_frame_ms_ >= dp::FAILSAFE_TIMEOUT_MS) {
+  now_ms_ = static_cast<uint16_t>(now_ms);
+  const uint16_t in_state = static_cast<uint16_t>(now_ms_ - state_since_ms_);
+  if (state_ != State::Failsafe && static_cast<uint16_t>(now_ms_ - last_frame_ms_) >= dp::FAILSAFE_TIMEOUT_MS) {
     // Link lost: this overrides any movement or sequence in progress.
     if (state_ == State::SelfTest) end_self_test();
     parser_.expire();  // a partial frame from before the silence never completes after it
@@ -262,7 +264,7 @@ void Drone::update(uint32_t now_ms) {
       break;
     case State::SelfTest: {
       // The next step is due (no division: a 32-bit one costs flash and time).
-      if (in_state >= static_cast<uint32_t>(test_step_ + 1u) * SELF_TEST_STEP_MS) {
+      if (in_state >= static_cast<uint16_t>((test_step_ + 1u) * SELF_TEST_STEP_MS)) {
         if (++test_step_ >= SELF_TEST_STEPS) {
           end_self_test();
           enter(State::Disarmed);

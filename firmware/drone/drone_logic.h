@@ -62,6 +62,9 @@ class Drone {
         laser_before_test_(false),
         replies_dropped_(0) {}
 
+  // Times are the millis() clock. The state machine keeps its low 16 bits: every span it measures (the
+  // longest is the self-test, under 5 s) is exact as long as update() runs at least every 65.5 s, which the
+  // sketch's loop() does every millisecond; 16-bit arithmetic saves about 200 bytes of AVR flash over 32.
   void begin(uint32_t now_ms);                 // boot: safe outputs, ready line
   // One serial byte; returns true when it completed a frame (which may have
   // changed the outputs).
@@ -110,9 +113,9 @@ class Drone {
   dp::StreamParser parser_;
   Outputs out_;
   State state_;
-  uint32_t now_ms_;
-  uint32_t state_since_ms_;
-  uint32_t last_frame_ms_;
+  uint16_t now_ms_;          // low 16 bits of the clock, as the spans below
+  uint16_t state_since_ms_;
+  uint16_t last_frame_ms_;
   dp::Error result_;             // set by the handler that dispatch() picked
   dp::Error last_parser_error_;  // the last reply, if it reported this parser error
   uint8_t test_step_;

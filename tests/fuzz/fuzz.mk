@@ -1,5 +1,6 @@
 # libFuzzer target for the generated C++ StreamParser / decode / encode (tests/fuzz/fuzz_stream_parser.cpp).
-# Included by the top Makefile:  `make fuzz-smoke` (part of `make test`, ~20 s)  and  `make fuzz` (5 minutes).
+# Included by the top Makefile:  `make fuzz-smoke` (part of `make test`, ~35 s: the shipped spec, then in crc8
+# mode)  and  `make fuzz` (5 minutes).
 # Everything is built into build/fuzz/; the growing corpus stays in build/fuzz/corpus between runs, and a crash
 # leaves its input in build/fuzz/artifacts/ (replay: build/fuzz/fuzz_stream_parser build/fuzz/artifacts/crash-...).
 # With FUZZ_JOBS > 1 each worker logs to build/fuzz/fuzz-N.log.
@@ -38,3 +39,27 @@ fuzz: $(FUZZ_BIN) $(FUZZ_DICT)
 	@mkdir -p $(FUZZ_DIR)/corpus $(FUZZ_DIR)/artifacts
 	cd $(FUZZ_DIR) && $(FUZZ_ENV) ./$(notdir $(FUZZ_BIN)) $(FUZZ_ARGS) -max_total_time=$(FUZZ_SECONDS) \
 	    $(if $(filter-out 1,$(FUZZ_JOBS)),-jobs=$(FUZZ_JOBS) -workers=$(FUZZ_JOBS)) corpus seeds
+
+# The same target against the shipped spec in integrity mode crc8 (check digits, BadCheck's counter slot), a
+# brief run on every `make test` too: build/fuzz/crc8 holds that spec, its generated library and its seeds.
+FUZZ_CRC8 := $(FUZZ_DIR)/crc8
+FUZZ_CRC8_SMOKE_SECONDS ?= 10
+
+$(FUZZ_CRC8)/generated/vectors.json: spec/drone.yaml $(wildcard generator/*.py generator/templates/arduino/*/src/*) \
+                                     | $(VENV_STAMP)
+	@mkdir -p $(FUZZ_CRC8)
+	@grep -q '^  integrity: none$$' $< || { echo "spec/drone.yaml: no '  integrity: none' line to switch" >&2; exit 1; }
+	@sed 's/^  integrity: none$$/  integrity: crc8/' $< > $(FUZZ_CRC8)/drone.yaml
+	@$(PY) -m generator --spec $(FUZZ_CRC8)/drone.yaml --out $(FUZZ_CRC8)/generated >/dev/null
+
+$(FUZZ_CRC8)/fuzz_stream_parser: tests/fuzz/fuzz_stream_parser.cpp $(FUZZ_CRC8)/generated/vectors.json | $(APT_STAMP)
+	$(FUZZ_CXX) $(FUZZ_CXXFLAGS) -I$(FUZZ_CRC8)/generated/arduino/DroneProtocol/src $< -o $@
+
+$(FUZZ_CRC8)/protocol.dict: $(FUZZ_CRC8)/generated/vectors.json tests/fuzz/make_fuzz_seeds.py | $(VENV_STAMP)
+	$(PY) tests/fuzz/make_fuzz_seeds.py $< $(FUZZ_CRC8)/seeds $@
+
+fuzz-smoke: fuzz-smoke-crc8
+.PHONY: fuzz-smoke-crc8
+fuzz-smoke-crc8: $(FUZZ_CRC8)/fuzz_stream_parser $(FUZZ_CRC8)/protocol.dict
+	@mkdir -p $(FUZZ_CRC8)/corpus $(FUZZ_CRC8)/artifacts
+	cd $(FUZZ_CRC8) && $(FUZZ_ENV) ./fuzz_stream_parser $(FUZZ_ARGS) -max_total_time=$(FUZZ_CRC8_SMOKE_SECONDS) corpus seeds

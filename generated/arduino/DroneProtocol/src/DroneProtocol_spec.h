@@ -44,6 +44,14 @@ inline void read_block(void* out, const void* p, size_t size) {
   memcpy(out, p, size);
 #endif
 }
+// Two adjacent bytes, the first in the low half.
+inline uint16_t read_pair(const uint8_t* p) {
+#ifdef __AVR__
+  return pgm_read_word(p);
+#else
+  return static_cast<uint16_t>(p[0] | p[1] << 8);
+#endif
+}
 inline uint16_t read_word(const uint16_t* p) {
 #ifdef __AVR__
   return pgm_read_word(p);
@@ -322,7 +330,7 @@ struct CommandInfo {
 
 namespace detail {
 // One flash array per attribute (not one array of structs): the linker drops the attributes a sketch never
-// reads, so the parser's own cost is 5 bytes per command (direction byte, minimum, maximum).
+// reads, so the parser's own cost is 2 bytes per command (its direction byte, its range index) and 4 per distinct range.
 constexpr uint8_t CATEGORY_COUNT = 5;
 // The category of a first byte in constant time: a dense table (category index + 1, 0 for none).
 constexpr uint8_t CATEGORY_FIRST = 105;
@@ -339,16 +347,21 @@ DRONE_PROTOCOL_FLASH const uint8_t DIRECTION_CODES[COMMAND_COUNT] = {
     'a', 'k', 's', 't', 'l',
 };
 
-DRONE_PROTOCOL_FLASH const uint16_t VALUE_MIN[COMMAND_COUNT] = {
-    1000, 1000, 1000, 1000, 1029, 1029, 1035, 1035, 1, 1, 1, 1, 0, 0, 0, 0,
-    0, 0, 0, 0, 0,
+// Each distinct value range once ({min, max}, side by side for one pass of lpm), and each command's range index:
+// commands share a handful of ranges.
+constexpr uint8_t RANGE_COUNT = 5;
+DRONE_PROTOCOL_FLASH const uint16_t VALUE_RANGES[RANGE_COUNT][2] = {
+    {1000, 2000}, {1029, 2012}, {1035, 2012}, {1, 180}, {0, 0},
+};
+DRONE_PROTOCOL_FLASH const uint8_t RANGE_OF[COMMAND_COUNT] = {
+    0, 0, 0, 0, 1, 1, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4,
+    4, 4, 4, 4, 4,
 };
 
-DRONE_PROTOCOL_FLASH const uint16_t VALUE_MAX[COMMAND_COUNT] = {
-    2000, 2000, 2000, 2000, 2012, 2012, 2012, 2012, 180, 180, 180, 180, 0, 0, 0, 0,
-    0, 0, 0, 0, 0,
-};
-
+// The {min, max} of a command's value.
+inline const uint16_t* value_range(CommandIndex index) {
+  return VALUE_RANGES[read_byte(&RANGE_OF[index])];
+}
 DRONE_PROTOCOL_FLASH const uint16_t DEFAULT_VALUES[COMMAND_COUNT] = {
     1600, 1400, 1400, 1600, 1621, 1421, 1424, 1624, 0, 0, 0, 0, 0, 0, 0, 0,
     0, 0, 0, 0, 0,
@@ -389,27 +402,33 @@ DRONE_PROTOCOL_ALWAYS_INLINE uint8_t category_slot(uint8_t byte) {
   return i < CATEGORY_SPAN ? read_byte(&CATEGORY_LOOKUP[i]) : 0;
 }
 
-// The direction bytes of each category in constant time: per category, a dense table from its lowest
-// direction byte (DIRECTION_FIRST) over DIRECTION_SPAN bytes to the command index + 1 (0: none), all in
-// DIRECTION_LOOKUP from DIRECTION_OFFSET. A scan of the category's directions cost ~10 cycles each.
-DRONE_PROTOCOL_FLASH const uint8_t DIRECTION_FIRST[CATEGORY_COUNT] = {98, 108, 100, 48, 97};
-DRONE_PROTOCOL_FLASH const uint8_t DIRECTION_SPAN[CATEGORY_COUNT] = {20, 7, 21, 63, 20};
-DRONE_PROTOCOL_FLASH const uint16_t DIRECTION_OFFSET[CATEGORY_COUNT] = {0, 20, 27, 48, 111};
-DRONE_PROTOCOL_FLASH const CommandIndex DIRECTION_LOOKUP[131] = {
-2, 0, 6, 0, 1, 0, 0, 0, 0, 0, 3, 0, 0, 0, 0, 0, 4, 0, 0, 5,  // move
-7, 0, 0, 0, 0, 0, 8,  // turn
-10, 0, 0, 0, 0, 0, 0, 0, 11, 0, 0, 0, 0, 0, 12, 0, 0, 9, 0, 0, 13,  // servo
-14, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 16, 0, 0, 0, 0, 0, 0, 0, 15,  // laser
-17, 0, 0, 0, 0, 0, 0, 0, 0, 0, 18, 21, 0, 0, 0, 0, 0, 0, 19, 20,  // init
-};
-
-// The command of category `category_index` with this direction byte: true and `index` set, or false.
+// The command of category `category_index` with this direction byte: true and `index` set, or false. A scan
+// of the category's direction bytes (at most 6, ~8 cycles each on the AVR): as fast here as a dense
+// per-category table, which costs ~150 bytes more flash for this spec. A spec with a category of more than
+// 8 directions gets dense tables instead.
 DRONE_PROTOCOL_ALWAYS_INLINE bool find_direction(uint8_t category_index, uint8_t direction, CommandIndex& index) {
-  const uint8_t i = static_cast<uint8_t>(direction - read_byte(&DIRECTION_FIRST[category_index]));
-  if (i >= read_byte(&DIRECTION_SPAN[category_index])) return false;
-  const CommandIndex slot = read_byte(&DIRECTION_LOOKUP[read_word(&DIRECTION_OFFSET[category_index]) + i]);
-  if (slot == 0) return false;
-  index = static_cast<CommandIndex>(slot - 1);
+  // This category's start and the next one's in one 16-bit read.
+  const uint16_t starts = read_pair(&CATEGORY_STARTS[category_index]);
+  const CommandIndex first = static_cast<CommandIndex>(starts & 0xFF);
+  uint8_t left = static_cast<uint8_t>((starts >> 8) - first);  // >= 1
+  const uint8_t* p = DIRECTION_CODES + first;
+#ifdef __AVR__
+  // 8 cycles a direction: what avr-gcc makes of the C loop below costs 14.
+  __asm__(
+      "1: lpm __tmp_reg__, Z+\n\t"
+      "cp __tmp_reg__, %[byte]\n\t"
+      "breq 2f\n\t"
+      "dec %[left]\n\t"
+      "brne 1b\n\t"
+      "2:"
+      : [left] "+r"(left), "+z"(p)
+      : [byte] "r"(direction));
+#else
+  for (; left != 0 && *p++ != direction; --left) {
+  }
+#endif
+  if (left == 0) return false;
+  index = static_cast<CommandIndex>(p - 1 - DIRECTION_CODES);
   return true;
 }
 
@@ -434,10 +453,10 @@ inline ChannelLimits channel_limits(Target target) {
 
 // The range of a command's value.
 inline uint16_t command_min(CommandId id) {
-  return detail::read_word(&detail::VALUE_MIN[static_cast<CommandIndex>(id)]);
+  return detail::read_word(&detail::value_range(static_cast<CommandIndex>(id))[0]);
 }
 inline uint16_t command_max(CommandId id) {
-  return detail::read_word(&detail::VALUE_MAX[static_cast<CommandIndex>(id)]);
+  return detail::read_word(&detail::value_range(static_cast<CommandIndex>(id))[1]);
 }
 // What a command drives, and which way (servo moves).
 inline Target command_target(CommandId id) {
