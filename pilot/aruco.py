@@ -23,7 +23,7 @@ import numpy as np
 from cv2.typing import MatLike
 
 from .config import ArucoConfig, VisionConfig
-from .detection import Candidate, Detection, frame_size, range_of
+from .detection import Candidate, Detection, best_detection, frame_size, range_of
 from .errors import ConfigError
 
 
@@ -97,11 +97,5 @@ class ArucoMarkerDetector:
         return found
 
     def detect(self, image: MatLike) -> Detection:
-        """This frame alone, the largest marker of the id (no tracking, no frame checks)."""
-        w, h = frame_size(image)
-        cands = self.candidates(image)
-        if not cands:
-            return Detection(False, width=w, height=h)
-        best = cands[0]
-        distance = range_of(best.size, self.cfg.marker_size_m, w, self.fov_deg)
-        return Detection(True, best.cx, best.cy, best.size, best.score, w, h, range_m=distance)
+        """This frame alone, the best candidate (no tracking, no frame checks)."""
+        return best_detection(self, image, self.cfg.marker_size_m, self.fov_deg)

@@ -86,3 +86,15 @@ def range_of(size_px: float, object_m: float, width: int, horizontal_fov_deg: fl
 def frame_size(image: MatLike) -> tuple[int, int]:
     h, w = image.shape[:2]
     return int(w), int(h)
+
+
+def best_detection(source: CandidateSource, image: MatLike, object_m: float, horizontal_fov_deg: float) -> Detection:
+    """This frame alone, the source's best candidate (no tracking, no frame checks: see
+    ``pilot.detect.make_detector``), with its pinhole range for an object ``object_m`` across."""
+    w, h = frame_size(image)
+    cands = source.candidates(image)
+    if not cands:
+        return Detection(False, width=w, height=h)
+    best = cands[0]
+    distance = range_of(best.size, object_m, w, horizontal_fov_deg)
+    return Detection(True, best.cx, best.cy, best.size, best.score, w, h, range_m=distance)

@@ -42,7 +42,7 @@ import numpy.typing as npt
 from cv2.typing import MatLike
 
 from .config import HsvConfig, VisionConfig
-from .detection import Candidate, Detection, frame_size, range_of
+from .detection import Candidate, Detection, best_detection, frame_size, range_of
 from .errors import ConfigError
 
 MAX_CANDIDATES = 4  # the largest search blobs refined; smaller ones cannot be the nearest target
@@ -267,11 +267,5 @@ class HsvBlobDetector:
         return found
 
     def detect(self, image: MatLike) -> Detection:
-        """This frame alone, best candidate (no tracking, no frame checks: see ``pilot.detect.make_detector``)."""
-        w, h = frame_size(image)
-        cands = self.candidates(image)
-        if not cands:
-            return Detection(False, width=w, height=h)
-        best = cands[0]
-        distance = range_of(best.size, self.cfg.target_diameter_m, w, self.fov_deg)
-        return Detection(True, best.cx, best.cy, best.size, best.score, w, h, range_m=distance)
+        """This frame alone, the best candidate (no tracking, no frame checks)."""
+        return best_detection(self, image, self.cfg.target_diameter_m, self.fov_deg)
