@@ -120,3 +120,8 @@ def type_name(kind: type) -> str:
 
 def is_int(node: Node | None) -> bool:
     return node is not None and isinstance(node.value, int) and not isinstance(node.value, bool)
+
+
+def is_code(code: str) -> bool:
+    """One printable ASCII character other than a space: what a category, direction or error code may be."""
+    return len(code) == 1 and 0x21 <= ord(code) <= 0x7E
