@@ -14,7 +14,7 @@ from .diff import Contract, contract, version_problem
 from .errors import SpecError, SpecInvalid
 from .model import INTEGRITY_MODES, Channel, ErrorKind, Field, Reply, Servo, Settled, Spec
 from .names import identifier_problem, protocol_name_problem, safe_file_name
-from .reader import Reader, is_code, is_int, kind_name
+from .reader import Reader, is_code, is_int, kind_name, unique_code
 from .source import INVALID, Node, display_path, load, read
 from .status import read_status
 from .widths import overflows
@@ -324,19 +324,11 @@ class _Builder(CommandsBuilder):
         kinds: list[ErrorKind] = []
         codes: dict[str, str] = {}
         for name, r in self._named_entries(top, "errors"):
-            code = r.text("code")
+            code = unique_code(r, "error", name, codes)
             description = r.text("description")
             r.finish()
-            if not is_code(code) or not code.isalnum():
-                r.error(r.node.children.get("code", r.node), f"error code {code!r} is not one letter or digit",
-                        path=r.sub("code"))
-                continue
-            if code in codes:
-                r.error(r.node.children["code"], f"error code '{code}' is already used by {codes[code]}",
-                        path=r.sub("code"))
-                continue
-            codes[code] = name
-            kinds.append(ErrorKind(len(kinds) + 1, name, code, description))
+            if code is not None:
+                kinds.append(ErrorKind(len(kinds) + 1, name, code, description))
         self._require_all(top, "errors", PARSER_ERRORS + REFUSALS, {k.name for k in kinds})
         # The parser's kinds come first, in a fixed order, so generated code can count them in one array.
         order = sorted(kinds, key=lambda k: (PARSER_ERRORS.index(k.name) if k.name in PARSER_ERRORS

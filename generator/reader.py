@@ -125,3 +125,24 @@ def is_int(node: Node | None) -> bool:
 def is_code(code: str) -> bool:
     """One printable ASCII character other than a space: what a category, direction or error code may be."""
     return len(code) == 1 and 0x21 <= ord(code) <= 0x7E
+
+
+def is_letter_code(code: str) -> bool:
+    """One ASCII letter or digit: what an error, state or laser code of a reply may be."""
+    return is_code(code) and code.isalnum()
+
+
+def unique_code(r: Reader, kind: str, name: str, codes: dict[str, str]) -> str | None:
+    """The `code` of entry `name` if it is one letter or digit that no other entry of `codes` took (then it is
+    recorded there); otherwise None, with the error reported at the code."""
+    code = r.text("code")
+    if not is_letter_code(code):
+        r.error(r.node.children.get("code", r.node), f"{kind} code {code!r} is not one letter or digit",
+                path=r.sub("code"))
+        return None
+    if code in codes:
+        r.error(r.node.children["code"], f"{kind} code '{code}' is already used by {codes[code]}",
+                path=r.sub("code"))
+        return None
+    codes[code] = name
+    return code

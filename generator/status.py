@@ -5,7 +5,7 @@ from __future__ import annotations
 from .errors import SpecError
 from .model import Status, StatusState
 from .names import identifier_problem
-from .reader import Reader
+from .reader import Reader, is_letter_code, unique_code
 
 # The firmware's state machine reports each of these; a spec must give every one a code.
 STATES = ("disarmed", "arming", "armed", "hold_altitude", "moving", "landing", "disarming", "self_test", "failsafe")
@@ -23,20 +23,12 @@ def read_status(top: Reader, errors: list[SpecError]) -> Status:
             continue
         if not r.ok:
             continue
-        code = r.text("code")
+        code = unique_code(r, "state", name, codes)
         armed = r.get("armed", bool)
         description = r.text("description")
         r.finish()
-        if not _is_letter(code):
-            r.error(r.node.children.get("code", r.node), f"state code {code!r} is not one letter or digit",
-                    path=r.sub("code"))
-            continue
-        if code in codes:
-            r.error(r.node.children["code"], f"state code '{code}' is already used by {codes[code]}",
-                    path=r.sub("code"))
-            continue
-        codes[code] = name
-        states.append(StatusState(name, code, bool(armed), description))
+        if code is not None:
+            states.append(StatusState(name, code, bool(armed), description))
     states_node = section.node.children.get("states") if section.ok else None
     if states_node is not None and isinstance(states_node.value, dict):
         for name in STATES:
@@ -47,7 +39,7 @@ def read_status(top: Reader, errors: list[SpecError]) -> Status:
     off, on = laser.text("off"), laser.text("on")
     laser.finish()
     for key, code in (("off", off), ("on", on)):
-        if laser.ok and key in laser.node.children and not _is_letter(code):
+        if laser.ok and key in laser.node.children and not is_letter_code(code):
             laser.error(laser.node.children[key], f"laser code {code!r} is not one letter or digit",
                         path=laser.sub(key))
     if off and off == on:
@@ -56,7 +48,3 @@ def read_status(top: Reader, errors: list[SpecError]) -> Status:
     order = {name: i for i, name in enumerate(STATES)}
     states.sort(key=lambda s: order.get(s.name, len(STATES)))
     return Status(tuple(states), off, on)
-
-
-def _is_letter(code: str) -> bool:
-    return len(code) == 1 and code.isascii() and code.isalnum()

@@ -161,9 +161,8 @@ def describe(frame: bytes, kind: ErrorKind, position: int) -> ProtocolError:
         spec = BY_BYTES[frame[0]][frame[1]]
         value = int(frame[2:FRAME_LENGTH])
         message = f"value {value} of {spec.name} is outside {spec.minimum}..{spec.maximum} {spec.unit}"
-    else:
-        message = (f"bytes {FRAME_LENGTH}..{WIRE_LENGTH - 1} ({frame[FRAME_LENGTH:]!r}) are not the frame's check"
-                   if kind is ErrorKind.BAD_CHECK else f"{kind.name.lower()} at byte {position}")
+    else:  # problem() finds no other kind: the frame's check
+        message = f"bytes {FRAME_LENGTH}..{WIRE_LENGTH - 1} ({frame[FRAME_LENGTH:]!r}) are not the frame's check"
     return ERRORS[kind](message, position)
 
 
