@@ -32,7 +32,7 @@ bench-vision: deps
 	PYTHONPATH=.:bench/vision $(PY) bench/vision/run.py $(BENCH_VISION_FLAGS)
 
 bench-protocol: deps
-	$(PY) bench/protocol/run.py --build $(BENCH_PROTOCOL_BUILD) $(BENCH_PROTOCOL_FLAGS)
+	$(PY) -m bench.protocol.run --build $(BENCH_PROTOCOL_BUILD) $(BENCH_PROTOCOL_FLAGS)
 	$(PY) -m bench.protocol.python_instructions
 
 bench-generator: deps
