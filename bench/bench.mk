@@ -1,7 +1,7 @@
 # Benchmarks, included by the top-level Makefile (paths relative to the repository root).
 #
 #   make bench-protocol   Python codec vs f-string/slice floors, C++ StreamParser throughput and instructions per
-#                         frame, parser flash/RAM on the ATmega328P, generator run time; writes
+#                         frame, parser flash/RAM on the ATmega328P; writes
 #                         bench/protocol/RESULTS.md
 #                         (and the Python codec's stream decoder in callgrind instructions against its floor:
 #                         bench/protocol/PYTHON_INSTRUCTIONS.md)
