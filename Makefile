@@ -10,11 +10,12 @@ VENV_STAMP := $(VENV)/.installed
 APT_STAMP := build/.apt-packages
 
 # Debian 12 packages: the AVR toolchain and Arduino core, arduino-builder (the IDE's builder) and avrdude,
-# simavr, host compilers, clang + libFuzzer, valgrind, Chromium and its WebDriver (the browser tests).
+# simavr, host compilers, clang + libFuzzer, valgrind, Chromium and its WebDriver (the browser tests),
+# Mesa's off-screen OpenGL (MuJoCo renders the simulator's camera headless).
 APT_PACKAGES := make gcc g++ python3 python3-venv python3-pip gcc-avr binutils-avr avr-libc arduino-core-avr \
                 arduino-builder avrdude \
                 simavr libsimavr-dev libelf-dev pkg-config clang libclang-rt-14-dev valgrind \
-                chromium chromium-driver
+                chromium chromium-driver libosmesa6 libgl1-mesa-dri libegl1
 
 .PHONY: all demo test deps generate check-generated lint typecheck pytest fuzz fuzz-smoke bench clean
 

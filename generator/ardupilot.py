@@ -16,6 +16,8 @@ MODE_NUMBERS = {"stabilize": 0, "alt_hold": 2}  # ArduCopter's mode numbers: Sta
 FS_THR_LAND = 3  # FS_THR_ENABLE: 1 = RTL (climbs to RTL_ALT: never indoors), 3 = always Land
 FS_THR_RANGE_US = (910, 1100)  # the range ArduPilot documents for FS_THR_VALUE
 STICKS = ("roll", "pitch", "throttle", "yaw")  # the channels RCMAP_* places
+THR_DZ_DEFAULT = 100  # ArduCopter's THR_DZ when the spec says nothing
+THR_DZ_RANGE = (0, 300)  # the range ArduPilot documents for THR_DZ
 
 
 @dataclass(frozen=True)
@@ -52,6 +54,8 @@ def parameters(spec: Spec) -> tuple[Param, ...]:
         out += [Param(f"RC{n}_MIN", channel.recorded_min, f"{where}[0]"),
                 Param(f"RC{n}_MAX", channel.recorded_max, f"{where}[1]"),
                 Param(f"RC{n}_TRIM", channel.median, f"{where} (midpoint: the median of Table 4)")]
+        if channel.name in spec.flight_controller.reversed:
+            out.append(Param(f"RC{n}_REVERSED", 1, f"flight_controller.reversed: {channel.name}"))
     throttle = channels["throttle"]
     fs_value = fs_thr_value(spec.failsafe_throttle_us, throttle.recorded_min)
     assert fs_value is not None, "the spec check (generator/hardware.py) rejects a spec without the gap"
@@ -59,6 +63,8 @@ def parameters(spec: Spec) -> tuple[Param, ...]:
                   "safety.failsafe_throttle_us: the radio failsafe lands (3; RTL would climb indoors)"),
             Param("FS_THR_VALUE", fs_value,
                   "safety.failsafe_throttle_us < FS_THR_VALUE < channels.throttle.recorded[0]")]
+    out.append(Param("THR_DZ", spec.flight_controller.throttle_dead_band,
+                     "flight_controller.throttle_dead_band: AltHold's dead band around mid-throttle"))
     out.append(Param("FLTMODE_CH", wiring.rc_input("mode"), "wiring.rc_inputs.mode"))
     for name, pulse in (("stabilize", spec.mode_stabilize_us), ("alt_hold", spec.mode_alt_hold_us)):
         slot, mode = mode_slot(pulse), MODE_NUMBERS[name]

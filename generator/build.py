@@ -136,6 +136,7 @@ class _Builder(CommandsBuilder):
         status = read_status(top, self.errors)
         settled = self._settled(top)
         project, wiring = hardware.read(top, channels, list(servos), failsafe_throttle, (stabilize, alt_hold))
+        flight_controller = hardware.flight_controller(top, channels)
         top.finish()
         if self.errors:
             return None
@@ -173,6 +174,7 @@ class _Builder(CommandsBuilder):
             settled=tuple(settled),
             project=project,
             wiring=wiring,
+            flight_controller=flight_controller,
         )
         for path, message in overflows(spec):
             node = self.node_at(path)

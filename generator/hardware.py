@@ -4,9 +4,9 @@ Called from one line of build.py; kept apart so that the ArduPilot-facing rules 
 
 from __future__ import annotations
 
-from .ardupilot import FS_THR_RANGE_US, STICKS, fs_thr_value, mode_slot
+from .ardupilot import FS_THR_RANGE_US, STICKS, THR_DZ_DEFAULT, THR_DZ_RANGE, fs_thr_value, mode_slot
 from .errors import SpecError
-from .model import Channel, Project, WiredPin, Wiring
+from .model import Channel, FlightControllerSetup, Project, WiredPin, Wiring
 from .reader import Reader, is_int
 from .source import Node
 
@@ -22,6 +22,33 @@ def read(top: Reader, channels: dict[str, Channel], servo_names: list[str], fail
     _check_failsafe_gap(top, channels, failsafe_throttle_us)
     _check_mode_slots(top, mode_pulses_us)
     return project, wiring
+
+
+def flight_controller(top: Reader, channels: dict[str, Channel]) -> FlightControllerSetup:
+    """The optional `flight_controller` section: ArduCopter's defaults when it is absent."""
+    node = top.child("flight_controller", required=False)
+    if node is None:
+        return FlightControllerSetup((), THR_DZ_DEFAULT)
+    r = Reader(node, "flight_controller", top.errors)
+    names: list[str] = []
+    listed = r.child("reversed", required=False)
+    if listed is not None:
+        if not isinstance(listed.value, list):
+            r.error(listed, f"expected a list of channel names, found {listed.value!r}", path=r.sub("reversed"))
+        for item in listed.items:
+            if item.value not in channels or item.value in names:
+                what = "listed twice" if item.value in names else "is not a channel"
+                r.error(item, f"'{item.value}' {what}", "known: " + ", ".join(channels), path=r.sub("reversed"))
+            else:
+                names.append(str(item.value))
+    dead_band = r.integer("throttle_dead_band", THR_DZ_DEFAULT)
+    dz_node = r.node.children.get("throttle_dead_band") if r.ok else None
+    if is_int(dz_node) and not THR_DZ_RANGE[0] <= dead_band <= THR_DZ_RANGE[1]:
+        assert dz_node is not None
+        r.error(dz_node, f"throttle_dead_band {dead_band} is not in {THR_DZ_RANGE[0]}..{THR_DZ_RANGE[1]}",
+                "ArduCopter's THR_DZ range", path=r.sub("throttle_dead_band"))
+    r.finish()
+    return FlightControllerSetup(tuple(names), dead_band)
 
 
 def _project(r: Reader) -> Project:

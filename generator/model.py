@@ -160,6 +160,14 @@ class Vector:
 
 
 @dataclass(frozen=True)
+class FlightControllerSetup:
+    """How the flight controller reads the sticks (spec section `flight_controller`, optional)."""
+
+    reversed: tuple[str, ...]  # channels ArduCopter must reverse (RCn_REVERSED)
+    throttle_dead_band: int  # THR_DZ, 0-1000 of the throttle range
+
+
+@dataclass(frozen=True)
 class Project:
     """Who publishes the generated library and packages (spec section `project`)."""
 
@@ -224,6 +232,7 @@ class Spec:
     settled: tuple[Settled, ...]
     project: Project
     wiring: Wiring
+    flight_controller: FlightControllerSetup
 
     @property
     def package_version(self) -> str:

@@ -16,6 +16,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 from types import FrameType
+from typing import TYPE_CHECKING
 
 import drone_protocol as dp
 
@@ -32,9 +33,10 @@ from .observers import LaserTally
 from .picam import PicameraSource
 from .record import Recorder
 from .runner import DryRunSink, Observer, RealPacer, Sink, StatusLine, run
-from .sim.camera import CameraModel, CameraPose, Renderer
-from .sim.flight import FlightResult, fly
-from .sim.room import SCENARIOS, make_scenario
+
+if TYPE_CHECKING:
+    from .sim.flight import FlightResult
+from .sim.room import SCENARIOS, make_scenario  # data only: the simulator itself (MuJoCo) is imported when used
 from .sources import CameraSource, Frame, FrameSource, ImageFolderSource, VideoFileSource
 
 EXIT_OK = 0
@@ -132,20 +134,19 @@ class _StillSim:
     """--dry-run without a frame source: the simulated room seen from the start pose, at altitude."""
 
     def __init__(self, scenario_name: str, seed: int, size: tuple[int, int]) -> None:
-        self.scenario = make_scenario(scenario_name, seed)
-        self.renderer = Renderer(self.scenario, CameraModel(*size))
-        x, y, heading = self.scenario.start
-        pan, tilt = dp.SERVOS[dp.ServoName.PAN], dp.SERVOS[dp.ServoName.TILT]
-        self.pose = CameraPose.from_drone(x, y, 1.2, heading, pan.default, tilt.default)
+        from .sim.camera import CameraModel
+        from .sim.still import StillView
+
+        self.view = StillView(make_scenario(scenario_name, seed), CameraModel(*size))
         self._index = 0
 
     def read(self) -> Frame | None:
-        frame = Frame(self.renderer.render(self.pose, self._index * 0.05), self._index * 0.05, self._index)
+        frame = Frame(self.view.render(self._index * 0.05), self._index * 0.05, self._index)
         self._index += 1
         return frame
 
     def close(self) -> None:
-        pass
+        self.view.close()
 
     def __enter__(self) -> _StillSim:
         return self
@@ -198,6 +199,9 @@ def _fly_sim(args: argparse.Namespace, cfg: PilotConfig) -> int:
 
 
 def _fly_sim_with(args: argparse.Namespace, cfg: PilotConfig, observers: list[Observer]) -> FlightResult:
+    from .sim.camera import CameraModel
+    from .sim.flight import fly
+
     return fly(
         args.scenario,
         args.seed,

@@ -86,6 +86,9 @@ class ControllerConfig:
     fire_tolerance: float = 0.10  # normalised error within which a frame counts as centred for the gate
     fire_range_max_m: float = 3.0  # the laser fires only on a target estimated closer than this
     blind_frames: int = 20  # bad frames in a row (black, saturated, frozen, malformed) before landing
+    # the flight controller holds altitude, not position: the pilot brakes from the closing speed it measures
+    brake_mps2: float = 0.5  # deceleration the approach plans with (a 5° lean gives about 0.9 m/s²)
+    approach_speed_mps: float = 0.6  # top closing speed
 
 
 @dataclass(frozen=True)
@@ -185,6 +188,8 @@ RANGES: dict[str, tuple[float, float]] = {
     "controller.approach_size": (0.001, 1.0),
     "controller.retreat_size": (0.0, 1.0),
     "controller.aim_tolerance": (0.001, 1.0),
+    "controller.brake_mps2": (0.05, 5.0),
+    "controller.approach_speed_mps": (0.05, 3.0),
     "link.rate_hz": (1.0, 50.0),
     "link.keepalive_fraction": (0.01, 0.99),
     "link.ready_timeout_s": (0.1, 60.0),

@@ -45,6 +45,7 @@ from collections.abc import Callable
 
 import drone_protocol as dp
 
+from .approach import ClosingSpeed, allowed_speed
 from .config import ControllerConfig
 from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, speed_for
 from .detection import Detection
@@ -57,8 +58,21 @@ class Controller(ControllerCore):
     def __init__(self, config: ControllerConfig | None = None, clock: Callable[[], float] = time.monotonic) -> None:
         super().__init__(config, clock)
         self.gate = Gate(self.cfg)  # vision gate (issue 12): every sighting and every laser-on goes through it
+        self.closing = ClosingSpeed()
+        self._brake_until_ms = 0  # target lost while closing in: brake this long before searching
+        self._brake_speed = 0.0
+
+    def _brake(self, speed: float) -> bytes:
+        """Pitch back against a closing speed: harder the faster it closes (up to 1.4 speed steps: a steeper
+        lean tilts the body-fixed camera off the target)."""
+        frac = min(1.4, 0.8 + speed)
+        return self._emit(dp.move_backward(speed_for(dp.CommandName.MOVE_BACKWARD, frac)))
 
     def _decide(self, det: Detection | None) -> bytes | None:
+        if det is not None and det.found and self.state in LOCKED:
+            self.closing.update(self._now() / 1000.0, det.range_m)
+        elif self.state not in LOCKED:
+            self.closing.reset()
         # -- vision gate (issue 12): a bad frame holds (laser off), too many in a row land ------------
         self.gate.observe(det)
         if self.gate.fault is not None and self.state in FLYING - {State.TAKEOFF, State.HOLD}:
@@ -78,6 +92,8 @@ class Controller(ControllerCore):
         if self._found(det):
             self._go(State.ACQUIRE, "target seen")
             return self._on_acquire(det)
+        if self._now() < self._brake_until_ms:
+            return self._brake(self._brake_speed)
         if self._now() - self._search_started_ms >= self.cfg.search_max_ms:
             self._go(State.LAND, "search sweep exhausted")
             return self._on_land(det)
@@ -96,8 +112,13 @@ class Controller(ControllerCore):
         return self._misses >= limit
 
     def _to_search(self, reason: str) -> bytes | None:
-        """Target lost: laser off first, then sticks neutral, then the servos home, then search."""
+        """Target lost: laser off first, then sticks neutral, then the servos home, then search; lost while
+        closing in, the search starts by braking for as long as the last closing speed needs."""
         off = self._laser(False)
+        closing = self.closing.closing
+        if closing is not None and closing > 0.15:
+            self._brake_until_ms = self._now() + round(1000.0 * closing / self.cfg.brake_mps2)
+            self._brake_speed = closing
         self._go(State.SEARCH, reason)
         return off if off is not None else self._emit(dp.hold_altitude())
 
@@ -144,6 +165,15 @@ class Controller(ControllerCore):
         if size >= cfg.approach_size:
             self._go(State.AIM, f"close enough (size {size:.3f})")
             return self._on_aim(det)
+        closing = self.closing.closing
+        if closing is not None and det.range_m > 0.0:
+            # the range still to go before the aim range (range scales as 1/size), and the speed allowed there
+            allowed = allowed_speed(det.range_m * (1.0 - size / cfg.approach_size), cfg.brake_mps2,
+                                    cfg.approach_speed_mps)
+            if closing > allowed + 0.15:
+                return self._brake(closing - allowed)
+            if closing > allowed - 0.1:
+                return self._emit(dp.hold_altitude())  # coasting at about the right speed
         frac = 1.8 if size < 0.45 * cfg.approach_size else (1.0 if size < 0.75 * cfg.approach_size else 0.6)
         self._coast = self._emit(dp.move_forward(speed_for(dp.CommandName.MOVE_FORWARD, frac)))
         return self._coast
@@ -183,6 +213,10 @@ class Controller(ControllerCore):
         if det.relative_size < self.cfg.retreat_size:
             self._go(State.TRACK, f"target receded (size {det.relative_size:.3f})")
             return self._on_track(det)
+        closing = self.closing.closing
+        if closing is not None and closing > 0.15:  # still coasting in: brake before anything else
+            self._centred = 0
+            return self._brake(closing)
         correction = self._servo_correction(det)
         if correction is not None:
             self._centred = 0

@@ -39,9 +39,8 @@ from pilot.detect import make_detector
 from pilot.link import Link, keepalive_ms
 from pilot.runner import run
 from pilot.sim.flight import SUCCESS_LIT_MS
-from pilot.sim.model import Outputs
 from pilot.sim.room import SCENARIOS, make_scenario
-from pilot.sim.virtual import Change, VirtualDrone
+from pilot.sim.virtual import Change, Outputs, VirtualDrone
 from pilot.sim.world import BOOT_MS, SimWorld
 
 HERE = Path(__file__).resolve().parent

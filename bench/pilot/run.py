@@ -19,15 +19,15 @@ import time
 from pathlib import Path
 
 import cv2
-import drone_protocol as dp
 import numpy as np
 
 from pilot.config import HsvConfig
 from pilot.detect import ArucoMarkerDetector, HsvBlobDetector
 from pilot.runner import Tick
-from pilot.sim.camera import CameraModel, CameraPose, Renderer
+from pilot.sim.camera import CameraModel
 from pilot.sim.flight import FlightJob, fly, fly_many
 from pilot.sim.room import SCENARIOS, make_scenario
+from pilot.sim.still import StillView
 
 HERE = Path(__file__).resolve().parent
 
@@ -46,17 +46,18 @@ def time_per_call(fn: object, image: np.ndarray, repeat: int) -> float:
 
 
 def frame_of(width: int, height: int) -> np.ndarray:
-    """A simulated view with the target, its marker and distractors in it."""
+    """A simulated view with the target, its marker and distractors in it, two metres from the target."""
     sc = make_scenario("distractor", 3)
-    r = Renderer(sc, CameraModel(width, height))
+    view = StillView(sc, CameraModel(width, height))
     x, y, _ = sc.start
     tx, ty, tz = sc.target.position
     heading = float(np.arctan2(ty - y, tx - x))
     d = float(np.hypot(tx - x, ty - y))
-    k = (d - 2.0) / d  # two metres from the target
-    pan0, tilt0 = dp.SERVOS[dp.ServoName.PAN].default, dp.SERVOS[dp.ServoName.TILT].default
-    pose = CameraPose.from_drone(x + (tx - x) * k, y + (ty - y) * k, tz - 0.2, heading, pan0, tilt0)
-    return r.render(pose, 0.0)
+    k = (d - 2.0) / d
+    view.place(x + (tx - x) * k, y + (ty - y) * k, tz - 0.2, heading)
+    img = view.render(0.0)
+    view.close()
+    return img
 
 
 def bench_detection(repeat: int) -> list[str]:

@@ -37,6 +37,7 @@ class FlightResult:
     success: bool  # reached the target and lit it
     lit_on_target_ms: int
     lit_elsewhere_ms: int
+    non_target_hits: int  # the laser came onto something that is not the target
     reached: bool
     min_distance: float
     wall_hits: int
@@ -50,13 +51,17 @@ class FlightResult:
     reconnects: int
     final_laser: bool  # the virtual drone's laser pin at the end
     final_armed: bool  # the firmware's state
-    final_fc_armed: bool  # the flight controller's (the model's, from the sticks)
+    final_fc_armed: bool  # the emulated flight controller's, from the sticks
     final_altitude: float
     confirmed: str = ""  # what the drone's last status reply said (state, laser)
     record_dir: str | None = None
     path_picture: str | None = None
     video: str | None = None
     error: str | None = None
+    physics_ms: float = 0.0  # wall time in physics and the flight controller
+    render_ms: float = 0.0  # wall time in MuJoCo's renderer
+    frames: int = 0
+    non_target_what: tuple[str, ...] = ()
 
     def summary(self) -> str:
         verdict = "reached and lit" if self.success else "FAILED"
@@ -64,6 +69,7 @@ class FlightResult:
             f"{self.scenario:10s} seed {self.seed:3d} {self.detector:5s} {verdict:15s} "
             f"lit {self.lit_on_target_ms:5d} ms "
             f"min dist {self.min_distance:4.2f} m walls {self.wall_hits} crashes {self.crashes} "
+            f"non-target {self.non_target_hits} "
             f"sim {self.sim_seconds:5.1f} s wall {self.wall_seconds:5.2f} s ({self.reason})"
             + ("" if self.confirmed in self.reason else f"; drone confirmed {self.confirmed}")
         )
@@ -80,6 +86,7 @@ class FlightJob:
     height: int = 240
     executable: str | None = None
     max_wind: float = 0.0
+    gusts: float = 0.0
 
 
 def fly(
@@ -96,11 +103,12 @@ def fly(
     lose_camera_at_s: float | None = None,
     observers: Sequence[Observer] = (),
     max_wind: float = 0.0,
+    gusts: float = 0.0,
 ) -> FlightResult:
     cfg = config or PilotConfig()
     if detector_name is not None:
         cfg = dataclasses.replace(cfg, detector=detector_name)
-    scenario = make_scenario(scenario_name, seed, noise=noise, max_wind=max_wind)
+    scenario = make_scenario(scenario_name, seed, noise=noise, max_wind=max_wind, gusts=gusts)
     detector = make_detector(cfg)
     recorder = Recorder(record_dir, fps=cfg.link.rate_hz) if record_dir is not None else None
     wall0 = time.perf_counter()
@@ -151,7 +159,7 @@ def fly(
                     observers=watchers,
                 )
             score = world.score
-            state = world.model.state
+            state = world.state
             picture = None
             if recorder is not None:
                 picture = str(recorder.path_png(scenario, score.path))
@@ -177,6 +185,7 @@ def fly(
                 success=success,
                 lit_on_target_ms=score.lit_on_target_ms,
                 lit_elsewhere_ms=score.lit_elsewhere_ms,
+                non_target_hits=score.non_target_hits,
                 reached=score.reached,
                 min_distance=score.min_distance,
                 wall_hits=state.wall_hits,
@@ -196,6 +205,10 @@ def fly(
                 record_dir=str(recorder.dir) if recorder is not None else None,
                 path_picture=picture,
                 video=str(recorder.video_path) if recorder is not None else None,
+                physics_ms=score.physics_ms,
+                render_ms=score.render_ms,
+                frames=score.frames,
+                non_target_what=tuple(score.non_target_what),
                 error=None if result.error is None else f"{type(result.error).__name__}: {result.error}",
             )
     finally:
@@ -213,6 +226,7 @@ def _fly_job(job: FlightJob) -> FlightResult:
         camera=CameraModel(job.width, job.height),
         executable=job.executable,
         max_wind=job.max_wind,
+        gusts=job.gusts,
     )
 
 

@@ -1,4 +1,6 @@
-"""The simulated room: geometry, the target, an ArUco marker plate, distractors, and named scenarios.
+"""The simulated room as data: geometry, the target, its ArUco plate, furniture, distractors, lights and wind,
+and the named scenarios. Nothing here renders or imports MuJoCo (``scene.py`` turns a Scenario into a model), so
+the pilot's command line can list the scenarios without the simulator's dependencies.
 
 World frame: x along the room's width, y along its depth, z up, metres; the origin is a floor corner.
 A heading (yaw) is measured counter-clockwise from +x, in radians. Everything is drawn from a
@@ -14,12 +16,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ConfigError
+from . import furnish
 
 Vec3 = tuple[float, float, float]
+RGB = tuple[float, float, float]
 BGR = tuple[int, int, int]
 
-TARGET_RED: BGR = (30, 30, 205)
-DISTRACTOR_COLOURS: tuple[BGR, ...] = ((0, 140, 255), (200, 90, 30), (50, 170, 50), (0, 210, 230), (150, 60, 150))
+TARGET_RGB: RGB = (0.80, 0.08, 0.07)
 
 
 @dataclass(frozen=True)
@@ -34,11 +37,38 @@ class Room:
 
 @dataclass(frozen=True)
 class Ball:
-    """A sphere on a thin pole standing on the floor: the target or a distractor."""
+    """The target: a sphere on a thin pole standing on the floor."""
 
     position: Vec3
     radius: float
-    colour: BGR
+    rgb: RGB = TARGET_RGB
+
+    @property
+    def colour(self) -> BGR:
+        return (int(self.rgb[2] * 255), int(self.rgb[1] * 255), int(self.rgb[0] * 255))
+
+
+@dataclass(frozen=True)
+class Prop:
+    """Furniture, clutter or a distractor: a box, sphere or cylinder standing in the room, or a poster (a
+    plane) on a wall. ``size`` is MuJoCo's: half-extents (box), radius (sphere), radius and half-height
+    (cylinder), half-width and half-height (poster). ``texture`` names a photograph (``textures.py``)."""
+
+    shape: str  # box, sphere, cylinder, poster
+    position: Vec3
+    size: Vec3
+    rgb: RGB
+    yaw: float = 0.0  # heading of the prop's +x axis (a poster's normal, into the room)
+    texture: str = ""
+    distractor: bool = False  # target-like colour: detecting it is a false detection
+
+    @property
+    def radius(self) -> float:
+        return max(self.size[0], self.size[1]) if self.shape != "sphere" else self.size[0]
+
+    @property
+    def colour(self) -> BGR:
+        return (int(self.rgb[2] * 255), int(self.rgb[1] * 255), int(self.rgb[0] * 255))
 
 
 @dataclass(frozen=True)
@@ -50,6 +80,13 @@ class MarkerPlate:
     side: float  # black-bordered marker side, metres
     marker_id: int
     dictionary: str = "DICT_4X4_50"
+
+
+@dataclass(frozen=True)
+class Light:
+    direction: Vec3  # where it shines
+    rgb: RGB  # colour times intensity
+    position: Vec3 = (5.0, 4.0, 2.9)
 
 
 @dataclass(frozen=True)
@@ -69,32 +106,76 @@ class Scenario:
     start: Vec3  # x, y, heading
     target: Ball
     marker: MarkerPlate | None
-    distractors: tuple[Ball, ...] = ()
+    props: tuple[Prop, ...] = ()
     hidden: tuple[Interval, ...] = ()  # times (s) when the target (and its marker) is covered
-    light_gain: float = 1.0  # mean lighting gain
-    light_wobble: float = 0.0  # amplitude of a slow lighting change
-    noise_sigma: float = 0.0  # Gaussian pixel noise
-    wind: tuple[float, float] = (0.0, 0.0)  # steady drift of the airborne drone, m/s along x and y
+    target_motion: Vec3 = (0.0, 0.0, 1.0)  # amplitude (m) along x, along y, period (s): a moving target
+    lights: tuple[Light, ...] = ()
+    ambient: float = 0.3
+    wall_texture: str = "brick"
+    floor_texture: str = "gravel"
+    window: bool = False  # a bright window on the wall behind the target (backlit)
+    exposure_s: float = 1.0 / 120.0  # the camera's exposure time: motion blur
+    noise_sigma: float = 0.0  # sensor noise at unit gain
+    jpeg_quality: int = 90
+    wind: tuple[float, float] = (0.0, 0.0)  # steady wind, m/s along x and y
+    gusts: float = 0.0  # gust strength, m/s (a seeded random process)
     time_budget_s: float = 60.0
     wall_margin: float = field(default=0.25)  # the drone's radius
 
     def target_visible(self, t: float) -> bool:
         return not any(iv.contains(t) for iv in self.hidden)
 
+    def target_offset(self, t: float) -> tuple[float, float]:
+        ax, ay, period = self.target_motion
+        s = math.sin(2.0 * math.pi * t / period)
+        return ax * s, ay * s
 
-SCENARIOS = ("ahead", "behind", "side", "high", "low", "hidden", "distractor")
+    @property
+    def distractors(self) -> tuple[Prop, ...]:
+        return tuple(p for p in self.props if p.distractor)
+
+
+BASIC = ("ahead", "behind", "side", "high", "low", "hidden", "distractor")
+SCENARIOS = (*BASIC, "cluttered", "red_distractors", "dim", "backlit", "moving_target", "marker_edge", "occluded")
 
 
 def _rng(name: str, seed: int) -> np.random.Generator:
     return np.random.default_rng([zlib.crc32(name.encode()), seed])
 
 
+def _bearing(name: str, rng: np.random.Generator) -> float:
+    if name == "behind":
+        return math.pi + math.radians(float(rng.uniform(-25.0, 25.0)))
+    if name == "side":
+        return float(rng.choice([-1.0, 1.0])) * math.radians(float(rng.uniform(70.0, 110.0)))
+    if name == "marker_edge":  # at the edge of the 60° view: the marker is cut by the frame's border
+        return float(rng.choice([-1.0, 1.0])) * math.radians(float(rng.uniform(24.0, 29.0)))
+    return math.radians(float(rng.uniform(-15.0, 15.0)))
+
+
+def _lights(name: str, rng: np.random.Generator, noise: bool) -> tuple[tuple[Light, ...], float]:
+    """Per-seed intensity, colour temperature (warm to cool) and direction."""
+    level = float(rng.uniform(0.7, 1.1)) if noise else 0.9
+    if name == "dim":
+        level = float(rng.uniform(0.18, 0.3))
+    warmth = float(rng.uniform(-1.0, 1.0)) if noise else 0.0
+    tint = (1.0 + 0.12 * warmth, 1.0, 1.0 - 0.15 * warmth)
+    lights = []
+    for k in range(2):
+        x = float(rng.uniform(2.0, 8.0))
+        y = float(rng.uniform(1.5, 6.5))
+        d = (float(rng.uniform(-0.4, 0.4)), float(rng.uniform(-0.4, 0.4)), -1.0)
+        gain = level * (0.6 if k else 0.5)
+        lights.append(Light(d, (gain * tint[0], gain * tint[1], gain * tint[2]), (x, y, 2.9)))
+    return tuple(lights), 0.25 * level
+
+
 def make_scenario(
-    name: str, seed: int, *, noise: bool = True, marker: bool = True, max_wind: float = 0.0
+    name: str, seed: int, *, noise: bool = True, marker: bool = True, max_wind: float = 0.0, gusts: float = 0.0
 ) -> Scenario:
-    """A named scenario; ``seed`` varies the start pose, the target's bearing, distance and height,
-    with ``noise`` the lighting and the pixel noise, and with ``max_wind`` (m/s) a steady wind up to it
-    (off by default: the pilot has no position hold while the target is out of sight, see README)."""
+    """A named scenario; ``seed`` varies the start pose, the target's bearing, distance and height, the
+    furniture, with ``noise`` the lighting, the sensor noise and the compression, and with ``max_wind`` (m/s) a
+    steady wind up to it and ``gusts`` (m/s) random gusts (both off by default: still air)."""
     if name not in SCENARIOS:
         raise ConfigError(f"unknown scenario {name!r}; known: {', '.join(SCENARIOS)}")
     rng = _rng(name, seed)
@@ -103,12 +184,7 @@ def make_scenario(
         sx = float(rng.uniform(1.5, room.width - 1.5))
         sy = float(rng.uniform(1.5, room.depth - 1.5))
         heading = float(rng.uniform(-math.pi, math.pi))
-        if name in ("ahead", "hidden", "distractor", "high", "low"):
-            bearing = math.radians(float(rng.uniform(-15.0, 15.0)))
-        elif name == "behind":
-            bearing = math.pi + math.radians(float(rng.uniform(-25.0, 25.0)))
-        else:  # side
-            bearing = float(rng.choice([-1.0, 1.0])) * math.radians(float(rng.uniform(70.0, 110.0)))
+        bearing = _bearing(name, rng)
         distance = float(rng.uniform(3.5, 6.0))
         tx = sx + distance * math.cos(heading + bearing)
         ty = sy + distance * math.sin(heading + bearing)
@@ -116,39 +192,33 @@ def make_scenario(
             break
     else:  # pragma: no cover - the ranges above always leave room
         raise ConfigError(f"scenario {name!r} seed {seed}: no valid placement")
-    if name == "high":
-        tz = float(rng.uniform(2.1, 2.4))
-    elif name == "low":
-        tz = float(rng.uniform(0.3, 0.5))
-    else:
-        tz = float(rng.uniform(1.0, 1.6))
-    target = Ball((tx, ty, tz), 0.15, TARGET_RED)
+    tz = {"high": (2.0, 2.3), "low": (0.35, 0.5)}.get(name, (1.0, 1.6))
+    target = Ball((tx, ty, float(rng.uniform(*tz))), 0.15)
     facing = math.atan2(sy - ty, sx - tx)  # the plate faces the start
     # the plate hangs on the target's pole, below the ball (above it for a low target)
-    plate_z = tz - 0.45 if tz >= 1.0 else tz + 0.45
+    plate_z = target.position[2] - 0.45 if target.position[2] >= 1.0 else target.position[2] + 0.45
     plate = MarkerPlate((tx, ty, plate_z), facing, 0.3, 7) if marker else None
-    distractors: list[Ball] = []
+    place = furnish.Placement(room.width, room.depth, (sx, sy), (tx, ty), rng)
+    props = furnish.furniture(place, crowded=name == "cluttered")
     if name == "distractor":
-        for k in range(3):
-            for _ in range(100):
-                d = float(rng.uniform(1.5, distance + 1.5))
-                b = heading + bearing + math.radians(float(rng.uniform(-35.0, 35.0)))
-                dx, dy = sx + d * math.cos(b), sy + d * math.sin(b)
-                # keep them out of the straight path to the target so they never block it for good
-                along = (dx - sx) * math.cos(heading + bearing) + (dy - sy) * math.sin(heading + bearing)
-                across = -(dx - sx) * math.sin(heading + bearing) + (dy - sy) * math.cos(heading + bearing)
-                if room.inside(dx, dy, 0.6) and (abs(across) > 0.8 or along > distance + 0.6):
-                    break
-            distractors.append(
-                Ball((dx, dy, float(rng.uniform(0.6, 2.0))), float(rng.uniform(0.12, 0.3)),
-                     DISTRACTOR_COLOURS[k % len(DISTRACTOR_COLOURS)])
-            )
+        props += furnish.coloured_balls(place)
+    if name == "red_distractors":
+        props += furnish.red_things(place)
+    if name == "occluded":
+        props += furnish.occluder(place, target.position, target.radius)
     hidden: tuple[Interval, ...] = ()
     if name == "hidden":
-        start = float(rng.uniform(8.0, 11.0))
-        hidden = (Interval(start, start + float(rng.uniform(1.5, 3.0))),)
+        begin = float(rng.uniform(8.0, 11.0))
+        hidden = (Interval(begin, begin + float(rng.uniform(1.5, 3.0))),)
+    motion = (0.0, 0.0, 1.0)
+    if name == "moving_target":  # sways across the view, up to 0.15 m/s
+        across = heading + bearing + math.pi / 2.0
+        amp = float(rng.uniform(0.3, 0.5))
+        motion = (amp * math.cos(across), amp * math.sin(across), float(rng.uniform(16.0, 22.0)))
+    lights, ambient = _lights(name, rng, noise)
     wind_speed = float(rng.uniform(0.0, 1.0)) * max_wind
     wind_dir = float(rng.uniform(-math.pi, math.pi))
+    dim = name == "dim"
     return Scenario(
         name=name,
         seed=seed,
@@ -156,10 +226,17 @@ def make_scenario(
         start=(sx, sy, heading),
         target=target,
         marker=plate,
-        distractors=tuple(distractors),
+        props=props,
         hidden=hidden,
-        light_gain=float(rng.uniform(0.75, 1.2)) if noise else 1.0,
-        light_wobble=float(rng.uniform(0.0, 0.15)) if noise else 0.0,
-        noise_sigma=float(rng.uniform(2.0, 6.0)) if noise else 0.0,
+        target_motion=motion,
+        lights=lights,
+        ambient=ambient,
+        wall_texture=str(rng.choice(furnish.WALL_TEXTURES)),
+        floor_texture=str(rng.choice(furnish.FLOOR_TEXTURES)),
+        window=name == "backlit",
+        exposure_s=(1.0 / 30.0 if dim else float(rng.uniform(1.0 / 200.0, 1.0 / 80.0))) if noise else 1.0 / 500.0,
+        noise_sigma=(float(rng.uniform(2.0, 5.0)) if noise else 0.0) * (2.5 if dim else 1.0),
+        jpeg_quality=int(rng.integers(70, 95)) if noise else 95,
         wind=(wind_speed * math.cos(wind_dir), wind_speed * math.sin(wind_dir)),
+        gusts=gusts,
     )

@@ -19,7 +19,6 @@ from typing import IO, Any
 
 from ..closing import Closing
 from ..errors import SimulatorError
-from .model import Outputs
 
 _TYPES: dict[Any, Any] = {"int": int, "float": float, "bool": bool, int: int, float: float, bool: bool}
 REPO = Path(__file__).resolve().parents[2]
@@ -36,6 +35,26 @@ def find_executable(explicit: str | Path | None = None) -> Path:
             f"(or point {ENV_VAR} at it)"
         )
     return candidate
+
+
+@dataclass(frozen=True)
+class Outputs:
+    """What the virtual drone's pins say at one moment."""
+
+    roll: int
+    pitch: int
+    throttle: int
+    yaw: int
+    mode: int
+    pan: float
+    tilt: float
+    laser: bool
+    armed: bool
+
+    @property
+    def pulses(self) -> tuple[float, float, float, float, float]:
+        """The RC pulses in the flight controller's order: roll, pitch, throttle, yaw, flight mode."""
+        return (self.roll, self.pitch, self.throttle, self.yaw, self.mode)
 
 
 @dataclass(frozen=True)

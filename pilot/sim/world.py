@@ -1,35 +1,48 @@
-"""The simulated world: the virtual drone's outputs move the kinematic model, the model's pose
-(with the pan/tilt servo angles) drives the camera, and the flight is scored.
+"""The simulated world: the virtual drone's RC pulses fly the airframe in MuJoCo (through the emulated
+ArduCopter), its servo outputs turn the camera and laser mount, and the flight is scored.
 
-``SimWorld`` is both the pilot's pacer (``now()``, ``wait_tick()`` steps the firmware's clock by one
-tick and integrates the model over it, following every output change at its millisecond) and, via
-``camera()``, its frame source.
+``SimWorld`` is both the pilot's pacer (``now()``; ``wait_tick()`` steps the firmware's clock by one tick and
+the physics over it, the pulses changing at the millisecond the firmware changed them) and, via ``camera()``,
+its frame source. The laser is a ray along the camera's axis: lit on the target's surface (the ball, or the
+marker plate when the pilot aims at the marker) within reach counts for the flight; lit on anything else is a
+non-target hit.
 """
 
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
+
+import numpy as np
 
 from ..closing import Closing
 from ..errors import FrameSourceError, SimulatorError
 from ..sources import Frame, FrameSourceBase
-from .camera import CameraModel, CameraPose, Image, Renderer
-from .model import DroneModel, ModelParams, Outputs, StickCentres
+from . import mj, rc
+from .camera import CameraModel, Image, Sensor
+from .physics import Airframe, AirframeState
 from .room import Scenario
-from .virtual import VirtualDrone
+from .scene import DRONE_GROUP, HIDDEN_GROUP, build
+from .virtual import Outputs, VirtualDrone
 
 BOOT_MS = 20  # the firmware boots and sends its ready line (39 bytes at 115200 baud: under 4 ms)
+STEP_MS = 2  # the physics' time step
 
 
 @dataclass
 class FlightScore:
-    lit_on_target_ms: int = 0  # laser on and its ray through the target, within reach
-    lit_elsewhere_ms: int = 0
+    lit_on_target_ms: int = 0  # laser on and its ray on the target's surface, within reach
+    lit_elsewhere_ms: int = 0  # laser on, its ray on anything else
+    non_target_hits: int = 0  # times the laser came on (or moved) onto something that is not the target
+    non_target_what: list[str] = field(default_factory=list)
     min_distance: float = math.inf
     reached: bool = False  # came within reach
     path: list[tuple[float, float, float, float]] = field(default_factory=list)  # t, x, y, z
     max_altitude: float = 0.0
+    physics_ms: float = 0.0  # wall time in physics and control
+    render_ms: float = 0.0  # wall time in MuJoCo's renderer
+    frames: int = 0
 
 
 class SimWorld(Closing):
@@ -40,30 +53,47 @@ class SimWorld(Closing):
         camera: CameraModel | None = None,
         *,
         tick_ms: int = 50,
-        substep_ms: int = 10,
         reach_m: float = 2.0,
         aim_point: str = "ball",
-        params: ModelParams | None = None,
+        params: rc.SimParams | None = None,
         lose_camera_at_s: float | None = None,
     ) -> None:
+        mujoco = mj.module()
         self.scenario = scenario
         self.vd = vd
         self.camera_model = camera or CameraModel()
-        self.renderer = Renderer(scenario, self.camera_model)
-        self.model = DroneModel(scenario.room, scenario.start, StickCentres.from_protocol(), params, scenario.wind)
+        self.params = params or rc.load()
+        built = build(scenario, self.params.airframe, self.camera_model.width, self.camera_model.height,
+                      self.camera_model.fovy_deg)
+        try:
+            self.mj_model = mujoco.MjModel.from_xml_string(built.xml, built.assets)
+        except ValueError as exc:  # pragma: no cover - the scene builder's own bug
+            raise SimulatorError(f"MuJoCo refused the scene: {exc}") from exc
+        self.mj_data = mujoco.MjData(self.mj_model)
+        self.airframe = Airframe(scenario, self.params, self.mj_model, self.mj_data)
+        self.sensor = Sensor(scenario, self.camera_model, self.mj_model, self.mj_data)
         self.tick_ms = tick_ms
-        self.substep_ms = substep_ms
         self.reach_m = reach_m
         self.aim_point = aim_point
         self.lose_camera_at_s = lose_camera_at_s
         self.score = FlightScore()
+        self._ray_groups = np.array([1 if g not in (DRONE_GROUP, HIDDEN_GROUP) else 0 for g in range(6)], np.uint8)
+        wanted = "target_marker" if aim_point == "marker" and scenario.marker is not None else "target_ball"
+        self._aim_geom = mujoco.mj_name2id(self.mj_model, mujoco.mjtObj.mjOBJ_GEOM, wanted)
+        self._last_hit = -1
         changes = vd.step(BOOT_MS)
         if vd.outputs is None:
             raise SimulatorError("virtual drone reported no outputs at boot")
         self.outputs: Outputs = vd.outputs
         self.fw_state = vd.state
         self.changes_seen = len(changes)
+        self._t_ms = vd.t_ms
+        self.sensor.aim(self.outputs.pan, self.outputs.tilt)
         self._record_path()
+
+    @property
+    def state(self) -> AirframeState:
+        return self.airframe.state
 
     # -- the pacer ------------------------------------------------------------------------------
     def now(self) -> float:
@@ -73,84 +103,91 @@ class SimWorld(Closing):
         self.advance(self.tick_ms)
 
     def advance(self, ms: int) -> None:
-        t0 = self.vd.t_ms
+        """Run the firmware ``ms`` milliseconds, then the physics over the same time in 2 ms steps, each with the
+        outputs the firmware had at the step's start."""
         changes = self.vd.step(ms)
         self.changes_seen += len(changes)
-        t = t0
-        outputs = self.outputs
         pending = list(changes)
         end = self.vd.t_ms
-        while t < end:
-            while pending and pending[0].t_ms <= t:
+        outputs = self.outputs
+        t0 = time.perf_counter()
+        while self._t_ms + STEP_MS <= end:
+            while pending and pending[0].t_ms <= self._t_ms:
                 outputs = pending.pop(0).outputs
-            nxt = min(end, t + self.substep_ms)
-            if pending:
-                nxt = min(nxt, max(pending[0].t_ms, t + 1))
-            dt_ms = nxt - t
-            self.model.step(outputs, dt_ms / 1000.0)
-            self._score(outputs, dt_ms)
-            t = nxt
+                self.sensor.aim(outputs.pan, outputs.tilt)
+            self.airframe.step(outputs.pulses, STEP_MS / 1000.0)
+            self._t_ms += STEP_MS
+            self._score(outputs, STEP_MS)
         for change in pending:
             outputs = change.outputs
         self.outputs = outputs
+        self.sensor.aim(outputs.pan, outputs.tilt)
         self.fw_state = self.vd.state
+        self.score.physics_ms += (time.perf_counter() - t0) * 1000.0
         self._record_path()
 
     # -- the camera -----------------------------------------------------------------------------
-    def pose(self) -> CameraPose:
-        s = self.model.state
-        return CameraPose.from_drone(s.x, s.y, s.z, s.heading, self.outputs.pan, self.outputs.tilt)
-
     def render(self) -> Image:
-        return self.renderer.render(self.pose(), self.now())
+        img = self.sensor.render(self.now())
+        self.score.render_ms += self.sensor.render_ms
+        self.score.frames += 1
+        return img
 
     def camera(self) -> SimCamera:
         return SimCamera(self)
 
     # -- scoring -------------------------------------------------------------------------------------
-    def aim_target(self) -> tuple[tuple[float, float, float], float]:
-        sc = self.scenario
-        if self.aim_point == "marker" and sc.marker is not None:
-            return sc.marker.centre, sc.marker.side / 2.0
-        return sc.target.position, sc.target.radius
+    def laser_hit(self) -> int:
+        """The geom the laser's ray meets first (-1: nothing)."""
+        mujoco = mj.module()
+        origin, axis = self.sensor.axis()
+        geom = np.array([-1], np.int32)
+        mujoco.mj_ray(self.mj_model, self.mj_data, origin, axis, self._ray_groups, 1, self.airframe.body, geom)
+        return int(geom[0])
 
     def laser_on_target(self) -> bool:
-        """Is the laser (on the camera mount, along its optical axis) hitting the target now?"""
-        pose = self.pose()
-        forward, _, _ = pose.axes()
-        (tx, ty, tz), radius = self.aim_target()
-        d = (tx - pose.position[0], ty - pose.position[1], tz - pose.position[2])
-        along = d[0] * forward[0] + d[1] * forward[1] + d[2] * forward[2]
-        if along <= 0:
-            return False
-        perp2 = d[0] ** 2 + d[1] ** 2 + d[2] ** 2 - along**2
-        return perp2 <= radius**2 and self.scenario.target_visible(self.now())
+        return self.laser_hit() == self._aim_geom
+
+    def target_position(self) -> tuple[float, float, float]:
+        geom = self._aim_geom
+        x, y, z = (float(v) for v in self.mj_data.geom_xpos[geom])
+        return x, y, z
 
     def distance(self) -> float:
-        s = self.model.state
-        (tx, ty, tz), _ = self.aim_target()
-        return math.dist((s.x, s.y, s.z), (tx, ty, tz))
+        s = self.state
+        return math.dist((s.x, s.y, s.z), self.target_position())
 
     def _score(self, outputs: Outputs, dt_ms: int) -> None:
         score = self.score
+        s = self.state
         dist = self.distance()
         score.min_distance = min(score.min_distance, dist)
         if dist <= self.reach_m:
             score.reached = True
-        score.max_altitude = max(score.max_altitude, self.model.state.z)
-        if outputs.laser:
-            if dist <= self.reach_m and self.laser_on_target():
-                score.lit_on_target_ms += dt_ms
-            else:
-                score.lit_elsewhere_ms += dt_ms
+        score.max_altitude = max(score.max_altitude, s.z)
+        if not outputs.laser:
+            self._last_hit = -1
+            return
+        hit = self.laser_hit()
+        if hit == self._aim_geom and dist <= self.reach_m:
+            score.lit_on_target_ms += dt_ms
+        else:
+            score.lit_elsewhere_ms += dt_ms
+            if hit != self._last_hit and hit != self._aim_geom:
+                score.non_target_hits += 1
+                mujoco = mj.module()
+                score.non_target_what.append(mujoco.mj_id2name(self.mj_model, mujoco.mjtObj.mjOBJ_GEOM, hit) or "?")
+        self._last_hit = hit
 
     def _record_path(self) -> None:
-        s = self.model.state
+        s = self.state
         self.score.path.append((self.now(), s.x, s.y, s.z))
 
     def close(self) -> None:
-        self.vd.close()
-
+        try:
+            self.sensor.close()
+        finally:
+            self.vd.close()
 
 
 class SimCamera(FrameSourceBase):

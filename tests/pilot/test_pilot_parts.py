@@ -1,4 +1,4 @@
-"""Config, calibration, frame sources, the kinematic model and the renderer."""
+"""Config, calibration and frame sources (the simulator: test_pilot_sim.py)."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ import numpy as np
 import pilot_synth as synth
 import pytest
 import yaml
+from pilot.sim.model import DroneModel, Outputs, StickCentres
 
 from pilot import config as config_mod
 from pilot.calibrate import calibrate_to_config, hsv_ranges_from_sample
@@ -19,7 +20,6 @@ from pilot.config import HsvConfig, PilotConfig
 from pilot.detect import HsvBlobDetector
 from pilot.errors import ConfigError, FrameSourceError
 from pilot.sim.camera import CameraModel, CameraPose, Renderer
-from pilot.sim.model import DroneModel, Outputs, StickCentres
 from pilot.sim.room import SCENARIOS, Room, make_scenario
 from pilot.sources import CameraSource, ImageFolderSource, VideoFileSource
 
@@ -192,141 +192,3 @@ def test_camera_source_reports_a_lost_camera(tmp_path: Path) -> None:
         src.read()
     src.close()
     src.close()
-
-
-# -- the kinematic model -------------------------------------------------------------------------------
-
-
-def neutral(**kw: int | bool) -> Outputs:
-    ch = dp.CHANNELS
-    base = {
-        "roll": ch["roll"].median,
-        "pitch": ch["pitch"].median,
-        "throttle": ch["throttle"].median,
-        "yaw": ch["yaw"].median,
-        "mode": 0,
-        "pan": dp.SERVOS[dp.ServoName.PAN].default,
-        "tilt": dp.SERVOS[dp.ServoName.TILT].default,
-        "laser": False,
-        "armed": True,  # the firmware's flag: the model does not read it
-    }
-    base.update(kw)
-    return Outputs(**base)  # type: ignore[arg-type]
-
-
-def airborne_model(heading: float = 0.0) -> DroneModel:
-    m = DroneModel(Room(), (5.0, 4.0, heading), StickCentres.from_protocol())
-    m.state.z = 1.0
-    m.state.armed = True
-    return m
-
-
-def run_model(m: DroneModel, out: Outputs, seconds: float) -> None:
-    for _ in range(round(seconds / 0.01)):
-        m.step(out, 0.01)
-
-
-def test_model_sticks_follow_the_seed_tables() -> None:
-    ch = dp.CHANNELS
-    m = airborne_model(heading=0.0)
-    run_model(m, neutral(pitch=ch["pitch"].high), 1.0)  # forward: +x for heading 0
-    assert m.state.x > 5.3 and abs(m.state.y - 4.0) < 0.01
-    m = airborne_model(heading=0.0)
-    run_model(m, neutral(roll=ch["roll"].high), 1.0)  # right: -y for heading 0
-    assert m.state.y < 3.7 and abs(m.state.x - 5.0) < 0.01
-    m = airborne_model()
-    run_model(m, neutral(yaw=ch["yaw"].high), 1.0)  # turn right: clockwise, heading decreases
-    assert -math.radians(70) < m.state.heading < -math.radians(30)
-    m = airborne_model()
-    run_model(m, neutral(throttle=ch["throttle"].high), 1.0)
-    assert m.state.z > 1.3
-    m = airborne_model()
-    run_model(m, neutral(pitch=ch["pitch"].median + 10, yaw=ch["yaw"].median - 10), 1.0)  # dead band
-    assert (m.state.x, m.state.y, m.state.heading) == (5.0, 4.0, 0.0)
-
-
-def test_model_walls_failsafe_and_disarm() -> None:
-    ch = dp.CHANNELS
-    m = airborne_model(heading=0.0)
-    run_model(m, neutral(pitch=ch["pitch"].maximum), 10.0)  # full forward into the +x wall
-    assert m.state.wall_hits == 1 and m.state.x == pytest.approx(Room().width - m.p.radius)
-    m = airborne_model()
-    run_model(m, neutral(throttle=dp.FAILSAFE_THROTTLE_US), 3.0)
-    assert m.state.z == 0.0 and m.state.crashes == 0  # the failsafe lands it
-    m = airborne_model()
-    m.state.armed = False  # forced: motors off in the air
-    run_model(m, neutral(), 2.0)
-    assert m.state.z == 0.0 and m.state.crashes == 1
-
-
-def test_model_arms_and_disarms_from_the_sticks_on_the_ground_only() -> None:
-    ch = dp.CHANNELS
-    arm = neutral(throttle=ch["throttle"].minimum, yaw=ch["yaw"].maximum)
-    disarm = neutral(throttle=ch["throttle"].minimum, yaw=ch["yaw"].minimum)
-    m = DroneModel(Room(), (5.0, 4.0, 0.0), StickCentres.from_protocol())
-    run_model(m, neutral(throttle=ch["throttle"].high), 1.0)
-    assert not m.state.armed and m.state.z == 0.0  # disarmed: throttle does nothing
-    run_model(m, arm, m.p.arm_hold_s / 2)
-    run_model(m, neutral(), 0.1)  # released too early: starts again
-    run_model(m, arm, m.p.arm_hold_s / 2)
-    assert not m.state.armed
-    run_model(m, arm, m.p.arm_hold_s)
-    assert m.state.armed
-    run_model(m, neutral(pitch=ch["pitch"].high, yaw=ch["yaw"].high), 1.0)  # on the ground: no sliding
-    assert (m.state.x, m.state.y, m.state.z) == (5.0, 4.0, 0.0)
-    run_model(m, neutral(throttle=ch["throttle"].high), 1.0)
-    assert m.state.z > 0.2
-    run_model(m, disarm, 0.3)  # throttle minimum descends at most max_climb: not a crash, still armed
-    assert m.state.armed
-    run_model(m, disarm, 3.0)  # landed, then disarmed by the held sticks
-    assert m.state.z == 0.0 and not m.state.armed and m.state.crashes == 0
-
-
-# -- the renderer -----------------------------------------------------------------------------------------
-
-
-@pytest.mark.parametrize("name", SCENARIOS)
-def test_scenarios_are_deterministic_and_inside_the_room(name: str) -> None:
-    for seed in range(20):
-        a, b = make_scenario(name, seed), make_scenario(name, seed)
-        assert a == b
-        tx, ty, tz = a.target.position
-        assert a.room.inside(tx, ty, 1.0) and 0.0 < tz < a.room.height
-        assert a.room.inside(a.start[0], a.start[1], 1.0)
-        for ball in a.distractors:
-            assert a.room.inside(ball.position[0], ball.position[1], 0.5)
-    assert make_scenario(name, 1) != make_scenario(name, 2)
-
-
-def test_render_is_deterministic_and_detects_where_it_projects() -> None:
-    sc = make_scenario("distractor", 4)
-    cam = CameraModel(320, 240)
-    x, y, _ = sc.start
-    tx, ty, _tz = sc.target.position
-    heading = math.atan2(ty - y, tx - x) + math.radians(8)
-    pose = CameraPose.from_drone(x, y, 1.2, heading, PAN0, TILT0)
-    a = Renderer(sc, cam).render(pose, 1.0)
-    b = Renderer(sc, cam).render(pose, 1.0)
-    assert np.array_equal(a, b)
-    projected = Renderer(sc, cam).project_point(pose, sc.target.position)
-    assert projected is not None
-    d = HsvBlobDetector().detect(a)
-    assert d.found
-    assert abs(d.cx - projected[0]) <= 1.5 and abs(d.cy - projected[1]) <= 1.5
-    expected = 2 * cam.focal * sc.target.radius / projected[2]
-    assert abs(d.size - expected) <= 2.5
-
-
-def test_render_tilt_moves_the_horizon_and_hidden_hides_the_target() -> None:
-    sc = make_scenario("hidden", 0, noise=False)
-    r = Renderer(sc, CameraModel(320, 240))
-    x, y, _ = sc.start
-    tx, ty, _ = sc.target.position
-    heading = math.atan2(ty - y, tx - x)
-    level = r.render(CameraPose.from_drone(x, y, 1.2, heading, PAN0, TILT0), 0.0)
-    up = r.render(CameraPose.from_drone(x, y, 1.2, heading, PAN0, TILT0 + 20), 0.0)
-    det = HsvBlobDetector()
-    d_level, d_up = det.detect(level), det.detect(up)
-    assert d_level.found and d_up.found and d_up.cy > d_level.cy + 50  # looking up: the target drops
-    during = r.render(CameraPose.from_drone(x, y, 1.2, heading, PAN0, TILT0), sc.hidden[0].start + 0.1)
-    assert not det.detect(during).found

@@ -177,9 +177,9 @@ def test_fault_in_any_stage_ends_laser_off_neutral_disarmed(stage: str, virtual_
         dp.CHANNELS[dp.ChannelName.PITCH].median,
         dp.CHANNELS[dp.ChannelName.YAW].median,
     )
-    assert f.world.model.state.z == 0.0 and f.world.model.state.crashes == 0
-    assert not f.world.model.state.armed  # the flight controller saw the disarm sticks
-    assert f.world.model.state.wall_hits == 0
+    assert f.world.state.z == 0.0 and f.world.state.crashes == 0
+    assert not f.world.state.armed  # the flight controller saw the disarm sticks
+    assert f.world.state.wall_hits == 0
 
 
 def test_lost_camera_lands_and_disarms(virtual_drone: Path) -> None:

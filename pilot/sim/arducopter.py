@@ -1,0 +1,202 @@
+"""An emulation of ArduCopter's Stabilize, AltHold and Land modes, stick arming and radio failsafe.
+
+It reads only the RC pulses (as the real flight controller does) and the airframe's attitude, rates and
+height, and returns four motor thrusts. What it reproduces, with ArduCopter's parameter names (``rc.py``):
+
+* roll/pitch stick -> lean angle, linear up to ``ANGLE_MAX`` with a circular limit, shaped by a first-order
+  filter of ``ATC_INPUT_TC``; a released stick levels the airframe and nothing holds position: it coasts;
+* yaw stick -> yaw rate up to ``PILOT_Y_RATE``;
+* Stabilize: throttle -> collective, mid-stick at ``MOT_THST_HOVER`` (ArduCopter's throttle curve);
+* AltHold: throttle -> climb rate with the ``THR_DZ`` dead band around mid-stick, up to ``PILOT_SPEED_UP`` /
+  ``PILOT_SPEED_DN`` with ``PILOT_ACCEL_Z``, and the altitude held when centred;
+* arming with throttle at zero and yaw right held ``ARM_DELAY_S``; disarming likewise with yaw left, landed only;
+* radio failsafe (throttle below ``FS_THR_VALUE``): disarm when landed, else Land (RTL falls back to Land
+  indoors without GPS) at ``LAND_SPEED``, and disarm on touchdown.
+
+Angles here are ArduCopter's (roll right, pitch nose-up and yaw clockwise positive); ``physics.py`` converts.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass
+
+from .rc import ANGLE_RANGE, THROTTLE_RANGE, SimParams
+
+GRAVITY = 9.81
+
+
+class Mode(enum.IntEnum):
+    STABILIZE = 0
+    ALT_HOLD = 2
+    LAND = 9
+
+
+@dataclass(frozen=True)
+class Sensors:
+    roll: float  # rad, right wing down positive
+    pitch: float  # rad, nose up positive
+    yaw: float  # rad, clockwise from above positive
+    roll_rate: float  # rad/s, the same senses
+    pitch_rate: float
+    yaw_rate: float
+    height: float  # m above the floor
+    climb: float  # m/s, up positive
+
+
+@dataclass(frozen=True)
+class Demand:
+    """What the attitude controller wants: angles (rad), yaw rate (rad/s) and collective (0..1 of full thrust)."""
+
+    roll: float
+    pitch: float
+    yaw_rate: float
+    collective: float
+    motors_on: bool
+
+
+def desired_climb_rate(params: SimParams, throttle: float) -> float:
+    """AltHold's climb rate (m/s) for a throttle of 0..1000 (Copter::get_pilot_desired_climb_rate); mid-stick is
+    the throttle's value halfway between its minimum and maximum (RC_Channel::get_control_mid)."""
+    ch = params.sticks["throttle"]
+    mid = ch.range((ch.minimum + ch.maximum) / 2.0)
+    dz = params["THR_DZ"]
+    top, bottom = mid + dz, mid - dz
+    up = params["PILOT_SPEED_UP"] / 100.0
+    down = (params["PILOT_SPEED_DN"] or params["PILOT_SPEED_UP"]) / 100.0
+    if throttle < bottom:
+        return down * (throttle - bottom) / bottom
+    if throttle > top:
+        return up * (throttle - top) / (THROTTLE_RANGE - top)
+    return 0.0
+
+
+def desired_lean(params: SimParams, roll_in: float, pitch_in: float) -> tuple[float, float]:
+    """Lean angles (rad) for stick angles of -4500..4500, with the circular ANGLE_MAX limit."""
+    angle_max = params["ANGLE_MAX"]
+    scale = angle_max / ANGLE_RANGE
+    roll, pitch = roll_in * scale, pitch_in * scale
+    total = math.hypot(roll, pitch)
+    if total > angle_max:
+        roll, pitch = roll * angle_max / total, pitch * angle_max / total
+    return math.radians(roll / 100.0), math.radians(pitch / 100.0)
+
+
+def stabilize_throttle(params: SimParams, throttle: float) -> float:
+    """Stabilize's collective (0..1) for a throttle of 0..1000, mid-stick at hover (get_pilot_desired_throttle)."""
+    thr = throttle / THROTTLE_RANGE
+    hover = params["MOT_THST_HOVER"]
+    expo = max(-0.5, min(1.0, -(hover - 0.5) / 0.375))
+    return thr * (1.0 - expo) + expo * thr**3
+
+
+class FlightController:
+    def __init__(self, params: SimParams, mass_kg: float, max_thrust_n: float) -> None:
+        self.p = params
+        self.hover = mass_kg * GRAVITY / max_thrust_n  # the collective that hovers (what MOT_THST_HOVER learns)
+        self.armed = False
+        self.landed = True
+        self.mode = Mode.STABILIZE
+        self.failsafe = False
+        self._arm_timer = 0.0
+        self._disarm_timer = 0.0
+        self._land_timer = 0.0
+        self._mode_pwm = -1.0
+        self._climb_cmd = 0.0  # m/s, slewed by PILOT_ACCEL_Z
+        self._alt_target = 0.0
+        self._roll = 0.0  # shaped lean targets, rad
+        self._pitch = 0.0
+
+    # -- the sticks --------------------------------------------------------------------------------------
+    def _arming(self, throttle_zero: bool, yaw_in: float, dt: float) -> None:
+        hold = self.p["ARM_DELAY_S"]
+        if throttle_zero and yaw_in > 4000.0 and not self.armed and self.landed and not self.failsafe:
+            self._arm_timer += dt
+            if self._arm_timer >= hold - 1e-9:
+                self.armed, self._arm_timer = True, 0.0
+                self._alt_target = 0.0
+        else:
+            self._arm_timer = 0.0
+        if throttle_zero and yaw_in < -4000.0 and self.armed and self.landed:
+            self._disarm_timer += dt
+            if self._disarm_timer >= hold - 1e-9:
+                self.armed, self._disarm_timer = False, 0.0
+        else:
+            self._disarm_timer = 0.0
+
+    def _modes(self, mode_pwm: float, throttle_pwm: float) -> None:
+        fs_on = self.p["FS_THR_ENABLE"] != 0 and throttle_pwm < self.p["FS_THR_VALUE"]
+        if fs_on and not self.failsafe:
+            self.failsafe = True
+            if self.armed and self.landed:
+                self.armed = False  # failsafe on the ground: disarm at once
+            elif self.armed:
+                self.mode = Mode.LAND  # RTL without GPS, or FS_THR_ENABLE 3: Land
+        elif not fs_on:
+            self.failsafe = False
+        if abs(mode_pwm - self._mode_pwm) > 10.0:  # the mode switch moved: a new mode (also after a failsafe)
+            self._mode_pwm = mode_pwm
+            if not self.failsafe:
+                number = self.p.mode_number(mode_pwm)
+                self.mode = Mode(number) if number in Mode._value2member_map_ else self.mode
+
+    # -- one control step ----------------------------------------------------------------------------------
+    def step(self, pulses: tuple[float, float, float, float, float], s: Sensors, dt: float) -> Demand:
+        """``pulses``: roll, pitch, throttle, yaw and flight-mode pulse widths (µs)."""
+        roll_pwm, pitch_pwm, throttle_pwm, yaw_pwm, mode_pwm = pulses
+        sticks = self.p.sticks
+        roll_in, pitch_in = sticks["roll"].angle(roll_pwm), sticks["pitch"].angle(pitch_pwm)
+        yaw_in, throttle = sticks["yaw"].angle(yaw_pwm), sticks["throttle"].range(throttle_pwm)
+        self._modes(mode_pwm, throttle_pwm)
+        self._arming(throttle <= 0.0, yaw_in, dt)
+        if not self.armed:
+            self._roll = self._pitch = self._climb_cmd = 0.0
+            self.landed = s.height < 0.05
+            return Demand(0.0, 0.0, 0.0, 0.0, False)
+        want_roll, want_pitch = desired_lean(self.p, roll_in, pitch_in)
+        yaw_rate = math.radians(self.p["PILOT_Y_RATE"]) * yaw_in / ANGLE_RANGE
+        if self.mode is Mode.LAND:
+            want_roll = want_pitch = yaw_rate = 0.0
+            collective, climb_demand = self._vertical(-self.p["LAND_SPEED"] / 100.0, s, dt)
+        elif self.mode is Mode.ALT_HOLD:
+            collective, climb_demand = self._vertical(desired_climb_rate(self.p, throttle), s, dt)
+        else:
+            collective = stabilize_throttle(self.p, throttle)
+            climb_demand = collective - self.hover
+            self._alt_target = s.height
+        self._land_detector(climb_demand, s, dt)
+        if self.landed:
+            # spooled down on the ground: no lean, no turn, motors at their floor until a climb is asked for
+            self._roll = self._pitch = 0.0
+            if self.mode is Mode.LAND or self.failsafe:
+                self.armed = False
+            return Demand(0.0, 0.0, 0.0, 0.0, self.armed)
+        a = min(1.0, dt / self.p["ATC_INPUT_TC"])
+        self._roll += (want_roll - self._roll) * a
+        self._pitch += (want_pitch - self._pitch) * a
+        tilt = max(0.5, math.cos(s.roll) * math.cos(s.pitch))
+        return Demand(self._roll, self._pitch, yaw_rate, collective / tilt, True)
+
+    def _vertical(self, climb_target: float, s: Sensors, dt: float) -> tuple[float, float]:
+        """AltHold's vertical controller: the collective (before tilt compensation) and the climb demand."""
+        step = self.p["PILOT_ACCEL_Z"] / 100.0 * dt
+        self._climb_cmd += max(-step, min(step, climb_target - self._climb_cmd))
+        if self.landed:
+            self._alt_target = s.height
+        self._alt_target += self._climb_cmd * dt
+        velocity = self._climb_cmd + self.p["PSC_POSZ_P"] * (self._alt_target - s.height)
+        accel = self.p["PSC_VELZ_P"] * (velocity - s.climb)
+        return max(0.0, self.hover * (1.0 + accel / GRAVITY)), self._climb_cmd
+
+    def _land_detector(self, climb_demand: float, s: Sensors, dt: float) -> None:
+        if climb_demand > 0.0:
+            self.landed = False
+            self._land_timer = 0.0
+            return
+        if s.height < 0.05 and abs(s.climb) < 0.3:
+            self._land_timer += dt
+            if self._land_timer >= self.p["LAND_DETECT_S"]:
+                self.landed = True
+        else:
+            self._land_timer = 0.0

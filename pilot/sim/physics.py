@@ -1,0 +1,185 @@
+"""The airframe in MuJoCo, flown by the emulated flight controller from the virtual drone's RC pulses.
+
+Each 2 ms step: the flight controller reads the pulses and the airframe's attitude, rates and height
+(``arducopter.py``), an attitude and rate loop turns its demand into four motor thrusts (MuJoCo's actuators add
+the motor lag and the reaction torques), drag against the moving air (steady wind plus seeded gusts) is applied,
+and MuJoCo integrates. Contacts are scored: a wall, furniture or target touch is a wall hit; touching the floor
+faster than the airframe's crash speed, or tipping over, is a crash.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+
+from . import mj
+from .arducopter import GRAVITY, FlightController, Sensors
+from .rc import SimParams
+from .room import Scenario
+from .scene import HIDDEN_GROUP, MOTOR_SPIN, motor_positions
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass
+class AirframeState:
+    """What the world reports and scores (world frame; heading counter-clockwise from +x)."""
+
+    x: float = 0.0
+    y: float = 0.0
+    z: float = 0.0
+    heading: float = 0.0
+    armed: bool = False  # the flight controller's arming
+    wall_hits: int = 0
+    crashes: int = 0
+    touching: bool = False
+    hit_what: list[str] = field(default_factory=list)  # what each wall hit touched, and when
+
+
+def _mixer(arm: float, yaw_moment: float) -> FloatArray:
+    """Thrusts from (collective force, roll torque, pitch torque, yaw torque) in the body frame (FLU)."""
+    rows = np.array([[1.0] * 4,
+                     [y for _, y in motor_positions(arm)],
+                     [-x for x, _ in motor_positions(arm)],
+                     [s * yaw_moment for s in MOTOR_SPIN]])
+    inverse: FloatArray = np.linalg.inv(rows)
+    return inverse
+
+
+class Airframe:
+    def __init__(self, scenario: Scenario, params: SimParams, model: mj.Model, data: mj.Data) -> None:
+        mujoco = mj.module()
+        self.sc, self.p, self.model, self.data = scenario, params, model, data
+        frame = params.airframe
+        self.frame = frame
+        self.fc = FlightController(params, frame.mass_kg, 4.0 * frame.motor_max_n)
+        self.state = AirframeState(x=scenario.start[0], y=scenario.start[1], heading=scenario.start[2])
+        self._mix_rows = _mixer(frame.arm_m, frame.yaw_moment_m).tolist()
+        self._kp_roll, self._kp_pitch = params["ATC_ANG_RLL_P"], params["ATC_ANG_PIT_P"]
+        self._spin_min_n = params["MOT_SPIN_MIN"] * frame.motor_max_n
+        self._moving = scenario.target_motion[0] != 0.0 or scenario.target_motion[1] != 0.0
+        self._hides = bool(scenario.hidden)
+        self.body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "drone")
+        self.target_body = model.body_mocapid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "target")]
+        self.target_home = np.array(model.body_pos[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "target")])
+        self.floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "floor")
+        self.airframe_geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "airframe")
+        self.target_geoms = [i for i in range(model.ngeom)
+                             if (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, i) or "").startswith("target_")]
+        self._hidden = False
+        self._on_floor = True
+        self._tipped = False
+        self._gust = np.zeros(2)
+        self._rng = np.random.default_rng([scenario.seed, 0x6057])
+        self.t = 0.0
+        mujoco.mj_forward(model, data)
+
+    # -- sensing ------------------------------------------------------------------------------------------
+    def sensors(self) -> Sensors:
+        w, x, y, z = self.data.qpos[3:7].tolist()
+        roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+        pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
+        yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+        v = self.data.qvel.tolist()  # angular part: body frame (FLU) for a free joint
+        # ArduCopter's senses: roll right-down (FLU +x), pitch nose-up (FLU -y), yaw clockwise (FLU -z)
+        return Sensors(roll, -pitch, -yaw, v[3], -v[4], -v[5], float(self.data.qpos[2]) - 0.05, v[2])
+
+    # -- one step -----------------------------------------------------------------------------------------
+    def step(self, pulses: tuple[float, float, float, float, float], dt: float) -> None:
+        mujoco = mj.module()
+        s = self.sensors()
+        demand = self.fc.step(pulses, s, dt)
+        frame = self.frame
+        ctrl = self.data.ctrl
+        if not demand.motors_on:
+            ctrl[:] = 0.0
+        else:
+            # angle loop (ArduCopter's senses) -> body rates (FLU) -> angular accelerations -> torques
+            rates = self.data.qvel
+            gain = frame.rate_gain
+            ix, iy, iz = frame.inertia
+            wrench = (demand.collective * 4.0 * frame.motor_max_n,
+                      ix * gain * (self._kp_roll * (demand.roll - s.roll) - rates[3]),
+                      iy * gain * (-self._kp_pitch * (demand.pitch - s.pitch) - rates[4]),
+                      iz * gain * (-demand.yaw_rate - rates[5]))
+            floor, top = self._spin_min_n, frame.motor_max_n
+            for i, row in enumerate(self._mix_rows):
+                thrust = row[0] * wrench[0] + row[1] * wrench[1] + row[2] * wrench[2] + row[3] * wrench[3]
+                ctrl[i] = floor if thrust < floor else top if thrust > top else thrust
+        self._air()
+        if self._moving or self._hides:
+            self._target()
+        mujoco.mj_step(self.model, self.data)
+        self.t += dt
+        if self.data.ncon:
+            self._score_contacts()
+        elif self.state.touching:
+            self.state.touching = False
+            self._on_floor = False
+        self._update_state()
+
+    def _air(self) -> None:
+        """Drag against the moving air: steady wind plus gusts (an Ornstein-Uhlenbeck process, 2 s memory)."""
+        sc, v = self.sc, self.data.qvel
+        wx, wy = sc.wind
+        if sc.gusts > 0.0:
+            theta, dt = 0.5, 0.002
+            g = self._gust
+            g += -theta * g * dt + sc.gusts * math.sqrt(2.0 * theta * dt) * self._rng.normal(size=2)
+            wx, wy = wx + float(g[0]), wy + float(g[1])
+        if self.data.qpos[2] <= 0.08:
+            wx = wy = 0.0  # on the ground the air does not push it
+        rx, ry, rz = v[0] - wx, v[1] - wy, v[2]
+        speed = math.sqrt(rx * rx + ry * ry + rz * rz)
+        k = -(self.frame.drag_linear + self.frame.drag_quadratic * speed)
+        f = self.data.xfrc_applied[self.body]
+        f[0], f[1], f[2] = k * rx, k * ry, k * rz
+
+    def _target(self) -> None:
+        dx, dy = self.sc.target_offset(self.t)
+        self.data.mocap_pos[self.target_body] = self.target_home + np.array([dx, dy, 0.0])
+        hidden = not self.sc.target_visible(self.t)
+        if hidden != self._hidden:
+            self._hidden = hidden
+            self.model.geom_group[self.target_geoms] = HIDDEN_GROUP if hidden else 0
+            self.model.geom_contype[self.target_geoms] = 0 if hidden else 1
+
+    def _score_contacts(self) -> None:
+        d, st = self.data, self.state
+        touching = False
+        for i in range(d.ncon):
+            c = d.contact[i]
+            pair = (int(c.geom1), int(c.geom2))
+            if self.airframe_geom not in pair:
+                continue
+            other = pair[0] if pair[1] == self.airframe_geom else pair[1]
+            if other == self.floor:
+                if -float(d.qvel[2]) > self.frame.crash_speed and not self._on_floor:
+                    st.crashes += 1
+                continue
+            if not st.touching and not touching:
+                name = mj.module().mj_id2name(self.model, mj.module().mjtObj.mjOBJ_GEOM, other) or "?"
+                st.hit_what.append(f"{name} at {self.t:.1f} s")
+            touching = True
+        self._on_floor = any(self.floor in (int(d.contact[i].geom1), int(d.contact[i].geom2)) for i in range(d.ncon))
+        if touching and not st.touching:
+            st.wall_hits += 1
+        st.touching = touching
+
+    def _update_state(self) -> None:
+        st, q = self.state, self.data.qpos.tolist()
+        st.x, st.y, st.z = q[0], q[1], max(0.0, q[2] - 0.05)
+        w, x, y, z = q[3:7]
+        st.heading = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+        st.armed = self.fc.armed
+        up = 1.0 - 2.0 * (x * x + y * y)  # the body's z axis against the world's
+        if up < 0.3 and not self._tipped:
+            self._tipped = True
+            st.crashes += 1
+
+    @property
+    def hover_collective(self) -> float:
+        return self.frame.mass_kg * GRAVITY / (4.0 * self.frame.motor_max_n)

@@ -1,0 +1,148 @@
+"""The simulated flight controller's parameters and how it reads the RC pulses, as ArduCopter does.
+
+Parameters come from ``arducopter.yaml`` (ArduCopter's names and defaults, plus the airframe), overridden by
+the generated parameter file the user loads into the real flight controller (``generated/ardupilot/drone.parm``):
+so the simulator flies with the same RC ranges, reversals, dead band, failsafe and mode slots.
+
+Stick reading follows ArduPilot's RC_Channel: roll, pitch and yaw are angles in -4500..4500 around the trim
+with a dead zone; the throttle is 0..1000 above its minimum plus a dead zone; a reversed channel is mirrored.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from ..errors import ConfigError
+
+HERE = Path(__file__).resolve().parent
+PARAMS_YAML = HERE / "arducopter.yaml"
+REPO_PARM = HERE.parents[1] / "generated" / "ardupilot" / "drone.parm"
+STICKS = ("roll", "pitch", "throttle", "yaw")
+MODE_SLOT_BOUNDS_US = (1230, 1360, 1490, 1620, 1749)  # ArduPilot's read_6pos_switch
+ANGLE_RANGE = 4500.0
+THROTTLE_RANGE = 1000.0
+
+
+@dataclass(frozen=True)
+class Airframe:
+    mass_kg: float
+    arm_m: float
+    inertia: tuple[float, float, float]
+    motor_max_n: float
+    motor_tau_s: float
+    yaw_moment_m: float
+    drag_linear: float
+    drag_quadratic: float
+    rate_gain: float
+    crash_speed: float
+    radius_m: float
+
+
+@dataclass(frozen=True)
+class Channel:
+    """One RC input as ArduCopter reads it."""
+
+    minimum: float
+    maximum: float
+    trim: float
+    reversed: bool
+    dead_zone: float
+
+    def angle(self, pwm: float) -> float:
+        """-4500..4500 around the trim, 0 inside the dead zone (RC_Channel::pwm_to_angle_dz)."""
+        if self.reversed:
+            pwm = self.trim - (pwm - self.trim)
+        hi, lo = self.trim + self.dead_zone, self.trim - self.dead_zone
+        if pwm > hi and self.maximum > hi:
+            value = ANGLE_RANGE * (pwm - hi) / (self.maximum - hi)
+        elif pwm < lo and lo > self.minimum:
+            value = ANGLE_RANGE * (pwm - lo) / (lo - self.minimum)
+        else:
+            value = 0.0
+        return max(-ANGLE_RANGE, min(ANGLE_RANGE, value))
+
+    def range(self, pwm: float) -> float:
+        """0..1000 above the minimum plus the dead zone (RC_Channel::pwm_to_range_dz)."""
+        pwm = max(self.minimum, min(self.maximum, pwm))
+        if self.reversed:
+            pwm = self.maximum - (pwm - self.minimum)
+        low = self.minimum + self.dead_zone
+        if pwm <= low:
+            return 0.0
+        return THROTTLE_RANGE * (pwm - low) / (self.maximum - low)
+
+
+@dataclass(frozen=True)
+class SimParams:
+    values: Mapping[str, float]  # ArduCopter's parameters by name
+    airframe: Airframe
+    sticks: Mapping[str, Channel]  # roll, pitch, throttle, yaw
+    source: str  # where the RC setup came from
+
+    def __getitem__(self, name: str) -> float:
+        return self.values[name]
+
+    def mode_number(self, pwm: float) -> int:
+        """The ArduCopter mode number the flight-mode pulse selects (FLTMODE1..6; 0, Stabilize, by default)."""
+        slot = 1 + sum(1 for bound in MODE_SLOT_BOUNDS_US if pwm > bound)
+        return int(self.values.get(f"FLTMODE{slot}", 0))
+
+
+def read_parm(path: Path) -> dict[str, float]:
+    """A Mission Planner parameter file: NAME,VALUE lines, # comments."""
+    out: dict[str, float] = {}
+    for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+        line = line.split("#", 1)[0].strip()
+        if not line:
+            continue
+        name, sep, value = line.partition(",")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError as exc:
+            raise ConfigError(f"{path}:{n}: not a NAME,VALUE line: {line!r}") from exc
+        if not sep:
+            raise ConfigError(f"{path}:{n}: not a NAME,VALUE line: {line!r}")
+    return out
+
+
+def _from_spec() -> dict[str, float]:
+    """Without a parameter file: the RC ranges from the codec's tables (the spec's recorded extremes)."""
+    import drone_protocol as dp
+
+    out: dict[str, float] = {}
+    for n, name in enumerate(STICKS, 1):
+        ch = dp.CHANNELS[dp.ChannelName(name)]
+        out |= {f"RCMAP_{name.upper()}": n, f"RC{n}_MIN": ch.minimum, f"RC{n}_MAX": ch.maximum,
+                f"RC{n}_TRIM": ch.median}
+    return out
+
+
+def load(parm: Path | None = REPO_PARM, overrides: Mapping[str, float] | None = None) -> SimParams:
+    data: dict[str, Any] = yaml.safe_load(PARAMS_YAML.read_text(encoding="utf-8"))
+    values: dict[str, float] = {k: float(v) for k, v in data["arducopter"].items()}
+    if parm is not None and parm.is_file():
+        values |= read_parm(parm)
+        source = str(parm)
+    else:
+        values |= _from_spec()
+        source = "the codec's channel table (no parameter file)"
+    values |= dict(overrides or {})
+    frame = data["airframe"]
+    airframe = Airframe(**{k: (tuple(float(x) for x in v) if isinstance(v, list) else float(v))
+                           for k, v in frame.items()})
+    sticks: dict[str, Channel] = {}
+    for name in STICKS:
+        n = int(values.get(f"RCMAP_{name.upper()}", STICKS.index(name) + 1))
+        try:
+            lo, hi = values[f"RC{n}_MIN"], values[f"RC{n}_MAX"]
+        except KeyError as exc:
+            raise ConfigError(f"simulator parameters: no {exc.args[0]} for the {name} input") from exc
+        trim = values.get(f"RC{n}_TRIM", (lo + hi) / 2.0)
+        dz = values["RC3_DZ"] if name == "throttle" else values["RC_DZ"]
+        sticks[name] = Channel(lo, hi, trim, bool(values.get(f"RC{n}_REVERSED", 0)), dz)
+    return SimParams(values, airframe, sticks, source)

@@ -1,0 +1,187 @@
+"""A Scenario as a MuJoCo model: the room textured with photographs, furniture, distractors, lights, the target
+(a mocap body: it can move) and the airframe with four thrust actuators and its pan/tilt camera.
+
+Geom groups: 0 what the camera sees, 3 the airframe (its own camera never sees it), 4 a hidden target.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from . import textures
+from .rc import Airframe
+from .room import Prop, Scenario
+
+DRONE_GROUP = 3
+HIDDEN_GROUP = 4
+CAMERA_POS = (0.23, 0.0, -0.03)  # on the airframe's nose, below the arms
+MOTOR_SPIN = (1, -1, 1, -1)  # front-left, front-right... alternating directions cancel the reaction torque
+
+
+@dataclass(frozen=True)
+class Built:
+    xml: str
+    assets: dict[str, bytes]
+
+
+def _f(*values: float) -> str:
+    return " ".join(f"{v:.6g}" for v in values)
+
+
+def _yaw_quat(yaw: float) -> str:
+    return _f(math.cos(yaw / 2.0), 0.0, 0.0, math.sin(yaw / 2.0))
+
+
+def motor_positions(arm: float) -> list[tuple[float, float]]:
+    """X configuration in the body frame (x forward, y left)."""
+    d = arm / math.sqrt(2.0)
+    return [(d, d), (d, -d), (-d, -d), (-d, d)]
+
+
+def _wall_plane(name: str, x: float, y: float, z: float, normal_heading: float, half: tuple[float, float],
+                material: str, offset: float = 0.0) -> str:
+    """A plane facing into the room (its normal along ``normal_heading``); x axis = up x normal."""
+    nx, ny = math.cos(normal_heading), math.sin(normal_heading)
+    return (f'<geom name="{name}" type="plane" pos="{_f(x + offset * nx, y + offset * ny, z)}" '
+            f'xyaxes="{_f(-ny, nx, 0, 0, 0, 1)}" size="{_f(half[0], half[1], 0.1)}" material="{material}"/>')
+
+
+class _Writer:
+    def __init__(self, scenario: Scenario) -> None:
+        self.sc = scenario
+        self.assets: dict[str, bytes] = {}
+        self.materials: list[str] = []
+
+    def photo_material(self, photo: str, repeat: tuple[float, float] = (1.0, 1.0), rgba: str = "1 1 1 1") -> str:
+        name = f"photo_{photo}_{len(self.materials)}"
+        file = f"{photo}.png"
+        if file not in self.assets:
+            self.assets[file] = textures.photo(photo)
+            self.materials.append(f'<texture name="tex_{photo}" type="2d" file="{file}"/>')
+        self.materials.append(f'<material name="{name}" texture="tex_{photo}" texrepeat="{_f(*repeat)}" '
+                              f'rgba="{rgba}"/>')
+        return name
+
+    def colour_material(self, name: str, rgb: tuple[float, float, float], emission: float = 0.0) -> str:
+        self.materials.append(f'<material name="{name}" rgba="{_f(*rgb, 1.0)}" emission="{emission:g}" '
+                              f'specular="0.2" shininess="0.3"/>')
+        return name
+
+    def prop(self, i: int, p: Prop) -> str:
+        name = f"{'distractor' if p.distractor else 'prop'}_{i}"
+        mat = self.photo_material(p.texture) if p.texture else self.colour_material(f"mat_{name}", p.rgb)
+        if p.shape == "poster":
+            return _wall_plane(name, p.position[0], p.position[1], p.position[2], p.yaw, (p.size[0], p.size[1]),
+                               mat, offset=0.01)
+        size = {"box": p.size, "sphere": p.size[:1], "cylinder": p.size[:2]}[p.shape]
+        return (f'<geom name="{name}" type="{p.shape}" pos="{_f(*p.position)}" quat="{_yaw_quat(p.yaw)}" '
+                f'size="{_f(*size)}" material="{mat}"/>')
+
+
+def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg: float) -> Built:
+    sc, room = scenario, scenario.room
+    w = _Writer(sc)
+    walls = w.photo_material(sc.wall_texture, (4.0, 1.5), "0.85 0.82 0.78 1")
+    floor = w.photo_material(sc.floor_texture, (6.0, 5.0), "0.7 0.68 0.62 1")
+    ceiling = w.colour_material("ceiling", (0.88, 0.88, 0.86))
+    target = w.colour_material("target", sc.target.rgb)
+    pole = w.colour_material("pole", (0.42, 0.42, 0.42))
+    w.colour_material("airframe", (0.1, 0.1, 0.1))
+    body: list[str] = [
+        f'<geom name="floor" type="plane" pos="{_f(room.width / 2, room.depth / 2, 0)}" '
+        f'size="{_f(room.width / 2, room.depth / 2, 0.1)}" material="{floor}"/>',
+        f'<geom name="ceiling" type="plane" pos="{_f(room.width / 2, room.depth / 2, room.height)}" '
+        f'xyaxes="1 0 0 0 -1 0" size="{_f(room.width / 2, room.depth / 2, 0.1)}" material="{ceiling}"/>',
+    ]
+    half_h = room.height / 2
+    for name, x, y, heading, length in (("wall_south", room.width / 2, 0.0, math.pi / 2, room.width),
+                                        ("wall_east", room.width, room.depth / 2, math.pi, room.depth),
+                                        ("wall_north", room.width / 2, room.depth, -math.pi / 2, room.width),
+                                        ("wall_west", 0.0, room.depth / 2, 0.0, room.depth)):
+        body.append(_wall_plane(name, x, y, half_h, heading, (length / 2, half_h), walls))
+    body += [w.prop(i, p) for i, p in enumerate(sc.props)]
+    tx, ty, tz = sc.target.position
+    if sc.window:  # a bright window on the wall behind the target, as seen from the start
+        body.append(_window(w, sc))
+    target_geoms = [
+        f'<geom name="target_pole" type="cylinder" pos="0 0 {tz / 2:.4g}" size="0.015 {tz / 2:.4g}" '
+        f'material="{pole}"/>',
+        f'<geom name="target_ball" type="sphere" pos="0 0 {tz:.4g}" size="{sc.target.radius:.4g}" '
+        f'material="{target}"/>',
+    ]
+    if sc.marker is not None:
+        plate = sc.marker
+        w.assets["marker.png"] = textures.marker(plate)
+        w.materials.append('<texture name="tex_marker" type="2d" file="marker.png"/>')
+        w.materials.append('<material name="marker" texture="tex_marker" rgba="1 1 1 1" specular="0"/>')
+        half = plate.side * 0.75
+        f = plate.facing
+        target_geoms.append(_wall_plane("target_marker", 0.0, 0.0, plate.centre[2], f, (half, half), "marker",
+                                        offset=0.011))
+        target_geoms.append(f'<geom name="target_backing" type="box" pos="0 0 {plate.centre[2]:.4g}" '
+                            f'quat="{_yaw_quat(f)}" size="{_f(0.01, half, half)}" material="{pole}"/>')
+    lights = [f'<light name="light_{i}" pos="{_f(*lt.position)}" dir="{_f(*lt.direction)}" '
+              f'diffuse="{_f(*lt.rgb)}" specular="0.1 0.1 0.1" castshadow="false" attenuation="1 0 0"/>'
+              for i, lt in enumerate(sc.lights)]
+    motors = motor_positions(frame.arm_m)
+    sites = "\n".join(f'      <site name="motor_{i}" pos="{_f(x, y, 0.02)}" size="0.01" group="{DRONE_GROUP}"/>'
+                      for i, (x, y) in enumerate(motors))
+    actuators = "\n".join(
+        f'    <general site="motor_{i}" gear="{_f(0, 0, 1, 0, 0, spin * frame.yaw_moment_m)}" dyntype="filter" '
+        f'dynprm="{frame.motor_tau_s:g}" gainprm="1" ctrllimited="true" ctrlrange="0 {frame.motor_max_n:g}"/>'
+        for i, spin in enumerate(MOTOR_SPIN))
+    sx, sy, heading = sc.start
+    ix, iy, iz = frame.inertia
+    amb = sc.ambient
+    xml = f"""<mujoco model="room">
+  <compiler angle="radian"/>
+  <option timestep="0.002"/>
+  <visual>
+    <global offwidth="{width}" offheight="{height}"/>
+    <headlight ambient="{_f(amb, amb, amb)}" diffuse="0 0 0" specular="0 0 0"/>
+    <quality shadowsize="0"/>
+  </visual>
+  <asset>
+    {chr(10).join('    ' + m for m in w.materials).strip()}
+  </asset>
+  <worldbody>
+    {chr(10).join('    ' + line for line in lights + body).strip()}
+    <body name="target" mocap="true" pos="{_f(tx, ty, 0)}">
+      {chr(10).join('      ' + g for g in target_geoms).strip()}
+    </body>
+    <body name="drone" pos="{_f(sx, sy, 0.06)}" quat="{_yaw_quat(heading)}">
+      <freejoint name="drone"/>
+      <inertial pos="0 0 0" mass="{frame.mass_kg:g}" diaginertia="{_f(ix, iy, iz)}"/>
+      <geom name="airframe" type="box" size="{_f(frame.radius_m, frame.radius_m, 0.05)}" mass="0"
+            group="{DRONE_GROUP}" material="airframe"/>
+{sites}
+      <camera name="eye" pos="{_f(*CAMERA_POS)}" fovy="{fovy_deg:.5g}"/>
+    </body>
+  </worldbody>
+  <actuator>
+{actuators}
+  </actuator>
+</mujoco>
+"""
+    return Built(xml, w.assets)
+
+
+def _window(w: _Writer, sc: Scenario) -> str:
+    """The wall point behind the target along the line from the start, with a bright emissive pane."""
+    sx, sy, _ = sc.start
+    tx, ty, _ = sc.target.position
+    room = sc.room
+    dx, dy = tx - sx, ty - sy
+    n = math.hypot(dx, dy)
+    dx, dy = dx / n, dy / n
+    ts = [t for t in ((room.width - tx) / dx if dx > 0 else -tx / dx if dx < 0 else math.inf,
+                      (room.depth - ty) / dy if dy > 0 else -ty / dy if dy < 0 else math.inf)]
+    t = min(ts)
+    x, y = tx + t * dx, ty + t * dy
+    if abs(t - ts[0]) < 1e-9:
+        heading = math.pi if dx > 0 else 0.0
+    else:
+        heading = -math.pi / 2 if dy > 0 else math.pi / 2
+    mat = w.colour_material("window", (1.0, 0.98, 0.92), emission=2.5)
+    return _wall_plane("window", x, y, 1.6, heading, (1.0, 0.8), mat, offset=0.02)

@@ -1,0 +1,182 @@
+"""The MuJoCo simulator: ArduCopter's stick mappings (one step input each, against the documented figure),
+arming, failsafe, the scenes and the camera/laser mount."""
+
+from __future__ import annotations
+
+import math
+
+import drone_protocol as dp
+import numpy as np
+import pytest
+
+from pilot.detect import HsvBlobDetector
+from pilot.sim import mj, rc
+from pilot.sim.arducopter import desired_climb_rate, desired_lean
+from pilot.sim.camera import CameraModel
+from pilot.sim.physics import Airframe
+from pilot.sim.room import SCENARIOS, make_scenario
+from pilot.sim.scene import HIDDEN_GROUP, build
+from pilot.sim.still import StillView
+
+CH = dp.CHANNELS
+PARAMS = rc.load()
+ALT_HOLD = dp.MODE_ALT_HOLD_US
+STABILIZE = dp.MODE_STABILIZE_US
+MEDIANS = {n: float(CH[dp.ChannelName(n)].median) for n in ("roll", "pitch", "throttle", "yaw")}
+
+
+class Rig:
+    """The airframe alone in a scenario's room, driven by pulses."""
+
+    def __init__(self, name: str = "ahead", seed: int = 0) -> None:
+        mujoco = mj.module()
+        sc = make_scenario(name, seed, noise=False)
+        built = build(sc, PARAMS.airframe, 64, 48, 45.0)
+        self.model = mujoco.MjModel.from_xml_string(built.xml, built.assets)
+        self.data = mujoco.MjData(self.model)
+        self.af = Airframe(sc, PARAMS, self.model, self.data)
+
+    def run(self, seconds: float, mode: float = ALT_HOLD, **sticks: float) -> None:
+        p = {**MEDIANS, **sticks}
+        for _ in range(round(seconds / 0.002)):
+            self.af.step((p["roll"], p["pitch"], p["throttle"], p["yaw"], mode), 0.002)
+
+    def airborne(self) -> Rig:
+        self.run(2.2, STABILIZE, throttle=CH["throttle"].minimum, yaw=CH["yaw"].maximum)
+        assert self.af.fc.armed
+        self.run(3.0, throttle=CH["throttle"].high)
+        self.run(2.0)
+        assert self.af.state.z > 1.0 and not self.af.fc.landed
+        return self
+
+
+def test_parameters_come_from_the_generated_file() -> None:
+    assert PARAMS.source.endswith("drone.parm")
+    assert PARAMS.sticks["pitch"].reversed  # the spec's flight_controller.reversed
+    assert PARAMS["THR_DZ"] < 100  # the spec's dead band, not ArduCopter's default
+    assert PARAMS.mode_number(ALT_HOLD) == 2 and PARAMS.mode_number(STABILIZE) == 0
+
+
+def test_mapping_lean_angle_is_linear_to_angle_max_with_a_circular_limit() -> None:
+    full = desired_lean(PARAMS, 4500.0, 0.0)
+    assert math.degrees(full[0]) == pytest.approx(PARAMS["ANGLE_MAX"] / 100.0)
+    both = desired_lean(PARAMS, 4500.0, 4500.0)
+    assert math.degrees(math.hypot(*both)) == pytest.approx(PARAMS["ANGLE_MAX"] / 100.0)
+    rig = Rig().airborne()
+    rig.run(1.0, roll=CH["roll"].maximum)  # a step: the airframe reaches ANGLE_MAX within a few time constants
+    assert math.degrees(rig.af.sensors().roll) == pytest.approx(PARAMS["ANGLE_MAX"] / 100.0, abs=1.5)
+
+
+def test_mapping_forward_leans_nose_down_and_a_released_stick_coasts() -> None:
+    rig = Rig().airborne()
+    h = rig.af.state.heading
+    x0, y0 = rig.af.state.x, rig.af.state.y
+    rig.run(1.5, pitch=CH["pitch"].high)  # move forward (Table 3): nose down, through RC2_REVERSED
+    assert rig.af.sensors().pitch < math.radians(-3)
+    rig.run(0.6)  # released: levels within ATC_INPUT_TC's few time constants ...
+    assert abs(math.degrees(rig.af.sensors().pitch)) < 1.0
+    v = np.asarray(rig.data.qvel[0:2])
+    along = float(v @ [math.cos(h), math.sin(h)])
+    assert along > 0.3  # ... and coasts on: no position hold
+    moved = (rig.af.state.x - x0) * math.cos(h) + (rig.af.state.y - y0) * math.sin(h)
+    assert moved > 0.3
+
+
+def test_mapping_yaw_stick_is_a_rate_up_to_pilot_y_rate() -> None:
+    rig = Rig().airborne()
+    h0 = rig.af.state.heading
+    rig.run(1.0, yaw=CH["yaw"].maximum)
+    rig.run(1.0, yaw=CH["yaw"].maximum)
+    turned = (h0 - rig.af.state.heading) % (2 * math.pi)  # right: clockwise, the heading decreases
+    rate = PARAMS["PILOT_Y_RATE"]
+    assert math.degrees(turned) == pytest.approx(rate * 2.0 - rate * 0.1, rel=0.12)
+
+
+def test_mapping_throttle_is_a_climb_rate_with_a_dead_band() -> None:
+    mid = MEDIANS["throttle"]
+    assert desired_climb_rate(PARAMS, PARAMS.sticks["throttle"].range(mid)) == 0.0
+    assert desired_climb_rate(PARAMS, 1000.0) == pytest.approx(PARAMS["PILOT_SPEED_UP"] / 100.0)
+    rig = Rig().airborne()
+    z0 = rig.af.state.z
+    rig.run(2.0)  # centred: the altitude is held
+    assert rig.af.state.z == pytest.approx(z0, abs=0.05)
+    want = desired_climb_rate(PARAMS, PARAMS.sticks["throttle"].range(CH["throttle"].high))
+    assert want > 0.3  # the spec's speed step is outside the dead band
+    rig.run(1.0, throttle=CH["throttle"].high)
+    z1 = rig.af.state.z
+    rig.run(1.0, throttle=CH["throttle"].high)
+    assert rig.af.state.z - z1 == pytest.approx(want, rel=0.15)
+
+
+def test_arming_needs_the_sticks_held_on_the_ground_and_the_failsafe_lands() -> None:
+    rig = Rig()
+    rig.run(1.0, STABILIZE, throttle=CH["throttle"].minimum, yaw=CH["yaw"].maximum)
+    rig.run(0.1, STABILIZE, throttle=CH["throttle"].minimum)  # released too early
+    rig.run(1.5, STABILIZE, throttle=CH["throttle"].minimum, yaw=CH["yaw"].maximum)
+    assert not rig.af.fc.armed
+    rig.airborne()
+    rig.run(3.0, throttle=CH["throttle"].minimum, yaw=CH["yaw"].minimum)  # disarm sticks in the air: refused
+    assert rig.af.fc.armed
+    rig.run(8.0, throttle=dp.FAILSAFE_THROTTLE_US)  # the radio failsafe: Land, then disarm on the ground
+    assert rig.af.state.z < 0.02 and not rig.af.fc.armed
+    assert rig.af.state.crashes == 0 and rig.af.state.wall_hits == 0
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_scenarios_are_deterministic_and_inside_the_room(name: str) -> None:
+    for seed in range(10):
+        a, b = make_scenario(name, seed), make_scenario(name, seed)
+        assert a == b
+        tx, ty, tz = a.target.position
+        assert a.room.inside(tx, ty, 1.0) and 0.0 < tz < a.room.height
+        assert a.room.inside(a.start[0], a.start[1], 1.0)
+        for prop in a.props:
+            if prop.shape != "poster":
+                assert a.room.inside(prop.position[0], prop.position[1], 0.2)
+    assert make_scenario(name, 1) != make_scenario(name, 2)
+    assert make_scenario("red_distractors", 1).distractors
+
+
+def test_render_is_deterministic_and_the_target_is_where_it_projects() -> None:
+    sc = make_scenario("distractor", 4)
+    x, y, _ = sc.start
+    tx, ty, tz = sc.target.position
+    heading = math.atan2(ty - y, tx - x) + math.radians(8)
+    frames = []
+    for _ in range(2):
+        view = StillView(sc, CameraModel(320, 240))
+        view.place(x, y, tz, heading)
+        frames.append(view.render(1.0))
+        projected = view.project(sc.target.position)
+        view.close()
+    assert np.array_equal(frames[0], frames[1])
+    assert projected is not None
+    d = HsvBlobDetector().detect(frames[0])
+    assert d.found
+    assert abs(d.cx - projected[0]) <= 3 and abs(d.cy - projected[1]) <= 3
+
+
+def test_tilt_moves_the_view() -> None:
+    sc = make_scenario("hidden", 0, noise=False)
+    view = StillView(sc, CameraModel(320, 240))
+    x, y, _ = sc.start
+    tx, ty, tz = sc.target.position
+    heading = math.atan2(ty - y, tx - x)
+    view.place(x, y, tz, heading)
+    level = view.project(sc.target.position)
+    tilt0 = dp.SERVOS[dp.ServoName.TILT].default
+    view.place(x, y, tz, heading, tilt=tilt0 + 10)  # looking up: the target drops in the frame
+    up = view.project(sc.target.position)
+    assert level is not None and up is not None and up[1] > level[1] + 30
+    d = HsvBlobDetector().detect(view.render(0.0))
+    assert d.found and abs(d.cy - up[1]) <= 4
+    view.close()
+
+
+def test_a_hidden_target_leaves_the_view_and_the_laser_path() -> None:
+    rig = Rig("hidden", 0)
+    begin = rig.af.sc.hidden[0].start
+    rig.run(begin - 0.1)
+    assert all(rig.model.geom_group[g] == 0 for g in rig.af.target_geoms)
+    rig.run(0.2)
+    assert rig.af.target_geoms and all(rig.model.geom_group[g] == HIDDEN_GROUP for g in rig.af.target_geoms)
