@@ -12,6 +12,10 @@
 #                         writes bench/vision/RESULTS.md (BENCH_VISION_FLAGS=--quick for a smoke run)
 #   make bench-tools      the standalone codec wheel's size and import time vs json; the live view's frame
 #                         latency and the pilot loop's rate with and without a viewer; writes bench/tools/RESULTS.md
+#   make bench-flight     the closed-loop campaign in the MuJoCo simulator: seeded flights per detector across
+#                         every scenario, still air and gusts; success, non-target laser hits, crashes, the
+#                         simulator's cost per frame; writes bench/flight/RESULTS.md (BENCH_FLIGHT_FLAGS=--seeds 2
+#                         for a shorter one)
 #   make bench            every part's benchmark: bench-protocol, bench-generator, bench-firmware
 #                         (firmware/firmware.mk), bench-pilot (pilot/pilot.mk), bench-vision, bench-ide
 #                         (bench/ide/bench.mk), bench-rust-c (tests/targets/targets.mk) and bench-tools
@@ -22,11 +26,16 @@ BENCH_PROTOCOL_BUILD ?= build/bench/protocol
 BENCH_PROTOCOL_FLAGS ?=
 
 BENCH_VISION_FLAGS ?=
+BENCH_FLIGHT_FLAGS ?=
 
-.PHONY: bench bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-ide bench-tools
+.PHONY: bench bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-ide bench-tools bench-flight
 
 # Run benchmarks one at a time (not with make -j): they time each other otherwise.
-bench: bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-ide bench-rust-c bench-tools
+bench: bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-ide bench-rust-c bench-tools \
+       bench-flight
+
+bench-flight: deps firmware-host
+	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.flight.run $(BENCH_FLIGHT_FLAGS)
 
 bench-vision: deps
 	PYTHONPATH=.:bench/vision $(PY) bench/vision/run.py $(BENCH_VISION_FLAGS)

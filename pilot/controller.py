@@ -53,6 +53,8 @@ from .gating import Gate
 
 __all__ = ["FLYING", "LOCKED", "Controller", "State", "Transition"]
 
+HOLD_MPS = 0.12  # closing speeds within this are left alone near the target (the estimate's noise)
+
 
 class Controller(ControllerCore):
     def __init__(self, config: ControllerConfig | None = None, clock: Callable[[], float] = time.monotonic) -> None:
@@ -61,6 +63,16 @@ class Controller(ControllerCore):
         self.closing = ClosingSpeed()
         self._brake_until_ms = 0  # target lost while closing in: brake this long before searching
         self._brake_speed = 0.0
+
+    def _hold_range(self) -> bytes | None:
+        """Near the target nothing holds position but the pilot: brake a closing speed, nudge forward against a
+        receding one; None while the range holds (within ``HOLD_MPS``)."""
+        closing = self.closing.closing
+        if closing is None or abs(closing) <= HOLD_MPS:
+            return None
+        if closing > 0.0:
+            return self._brake(closing)
+        return self._emit(dp.move_forward(speed_for(dp.CommandName.MOVE_FORWARD, min(1.2, 0.6 - closing))))
 
     def _brake(self, speed: float) -> bytes:
         """Pitch back against a closing speed: harder the faster it closes (up to 1.4 speed steps: a steeper
@@ -213,10 +225,10 @@ class Controller(ControllerCore):
         if det.relative_size < self.cfg.retreat_size:
             self._go(State.TRACK, f"target receded (size {det.relative_size:.3f})")
             return self._on_track(det)
-        closing = self.closing.closing
-        if closing is not None and closing > 0.15:  # still coasting in: brake before anything else
+        hold = self._hold_range()
+        if hold is not None:  # still coasting in (or drifting away): that first
             self._centred = 0
-            return self._brake(closing)
+            return hold
         correction = self._servo_correction(det)
         if correction is not None:
             self._centred = 0
@@ -261,4 +273,7 @@ class Controller(ControllerCore):
             return on
         # still within the loose tolerance: keep centring it (a drifting drone), the laser stays on
         correction = self._servo_correction(det)
-        return correction if correction is not None else self._emit(dp.hold_altitude())
+        if correction is not None:
+            return correction
+        hold = self._hold_range()
+        return hold if hold is not None else self._emit(dp.hold_altitude())

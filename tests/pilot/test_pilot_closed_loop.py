@@ -1,117 +1,61 @@
-"""Closed-loop flights: the pilot flies the simulated room against the real virtual drone over a
-pseudo-terminal, stepped clock; 20 seeds per scenario, in a process pool.
+"""Closed-loop flights in the MuJoCo simulator: the pilot flies against the real virtual drone over a
+pseudo-terminal, stepped clock, through the emulated ArduCopter; a representative dozen (the campaign of
+hundreds is bench/flight, `make bench-flight`).
 
-Each scenario must reach and light the target (laser on it, within reach, for the success time) in
-at least 95 % of its flights, and no flight may ever touch a wall or crash."""
+Every flight must end landed, disarmed, laser off; none may light anything but the target, touch a wall or
+crash; and at least 11 of the 12 must reach and light the target (the campaign measures the rate itself)."""
 
 from __future__ import annotations
 
 import math
-from collections import defaultdict
 from pathlib import Path
 
 import pytest
 
 from pilot.sim.flight import SUCCESS_LIT_MS, FlightJob, FlightResult, fly, fly_many
-from pilot.sim.room import SCENARIOS, make_scenario
+from pilot.sim.room import make_scenario
 
-SEEDS = range(20)
-# The ArUco path flies at 640x480 (the plate is too few pixels at 320x240 from 5 m) and its detector
-# costs ~2.7 ms a frame: a smaller set of seeds checks that it flies, the HSV sets carry the statistics.
-ARUCO_SCENARIOS = ("ahead", "side")
-ARUCO_SEEDS = range(5)
-# A steady wind (up to 0.1 m/s, seeded direction) that the pilot must keep correcting: a few seeds of each scenario.
-WIND = 0.1
-WIND_SEEDS = range(100, 104)
-REQUIRED = 0.95
+HSV_DOZEN = ("ahead", "behind", "side", "high", "low", "hidden", "distractor", "cluttered", "red_distractors", "dim")
+ARUCO_PAIR = ("ahead", "marker_edge")
+SEED = 3
+REQUIRED = 11
 
 
 @pytest.fixture(scope="module")
-def flights(virtual_drone: Path) -> dict[tuple[str, str], list[FlightResult]]:
-    jobs = [FlightJob(name, seed, "hsv", executable=str(virtual_drone)) for name in SCENARIOS for seed in SEEDS]
-    jobs += [
-        FlightJob(name, seed, "aruco", width=640, height=480, executable=str(virtual_drone))
-        for name in ARUCO_SCENARIOS
-        for seed in ARUCO_SEEDS
-    ]
-    jobs += [
-        FlightJob(name, seed, "hsv", max_wind=WIND, executable=str(virtual_drone))
-        for name in SCENARIOS
-        for seed in WIND_SEEDS
-    ]
+def flights(virtual_drone: Path) -> list[FlightResult]:
+    jobs = [FlightJob(name, SEED, "hsv", executable=str(virtual_drone)) for name in HSV_DOZEN]
+    jobs += [FlightJob(name, SEED, "aruco", width=640, height=480, executable=str(virtual_drone))
+             for name in ARUCO_PAIR]
     results = fly_many(jobs, processes=2)
-    by: dict[tuple[str, str], list[FlightResult]] = defaultdict(list)
     for job, result in zip(jobs, results, strict=True):
         assert (result.scenario, result.seed, result.detector) == (job.scenario, job.seed, job.detector)
-        detector = job.detector + ("+wind" if job.max_wind else "")
-        by[(detector, job.scenario)].append(result)
-    return dict(by)
+    return results
 
 
-CASES = (
-    [("hsv", name) for name in SCENARIOS]
-    + [("aruco", name) for name in ARUCO_SCENARIOS]
-    + [("hsv+wind", name) for name in SCENARIOS]
-)
-SEEDS_OF = {"hsv": SEEDS, "aruco": ARUCO_SEEDS, "hsv+wind": WIND_SEEDS}
-
-
-@pytest.mark.parametrize("detector,scenario", CASES)
-def test_scenario_reaches_and_lights_the_target(
-    detector: str, scenario: str, flights: dict[tuple[str, str], list[FlightResult]]
-) -> None:
-    results = flights[(detector, scenario)]
-    assert len(results) == len(SEEDS_OF[detector])
-    ok = [r for r in results if r.success]
-    failures = "\n".join(r.summary() for r in results if not r.success)
-    assert len(ok) >= math.ceil(REQUIRED * len(results)), f"{len(ok)}/{len(results)} succeeded:\n{failures}"
+def test_the_dozen_reach_and_light_the_target(flights: list[FlightResult]) -> None:
+    ok = [r for r in flights if r.success]
+    failures = "\n".join(r.summary() for r in flights if not r.success)
+    assert len(ok) >= REQUIRED, f"{len(ok)}/{len(flights)} succeeded:\n{failures}"
     for r in ok:
         assert r.lit_on_target_ms >= SUCCESS_LIT_MS and r.reached and r.fired
         assert r.min_distance <= 2.0
 
 
-@pytest.mark.parametrize("detector,scenario", CASES)
-def test_scenario_never_hits_a_wall_or_crashes(
-    detector: str, scenario: str, flights: dict[tuple[str, str], list[FlightResult]]
-) -> None:
-    for r in flights[(detector, scenario)]:
+def test_no_flight_lights_anything_else_touches_a_wall_or_crashes(flights: list[FlightResult]) -> None:
+    for r in flights:
+        assert r.non_target_hits == 0, (r.summary(), r.non_target_what)
         assert r.wall_hits == 0, r.summary()
         assert r.crashes == 0, r.summary()
         assert not r.final_laser and not r.final_armed and not r.final_fc_armed, r.summary()
-        assert r.final_altitude == 0.0, r.summary()
+        assert r.final_altitude < 0.02, r.summary()
         assert r.error is None, r.summary()
-
-
-def test_every_flight_ends_landed_and_disarmed(flights: dict[tuple[str, str], list[FlightResult]]) -> None:
-    everything = [r for rs in flights.values() for r in rs]
-    assert len(everything) == sum(len(SEEDS_OF[detector]) for detector, _ in CASES)
-    assert all(r.final_state == "done" for r in everything)
-
-
-def test_scenarios_really_differ(flights: dict[tuple[str, str], list[FlightResult]]) -> None:
-    """The hidden scenario does lose the target; behind and side need a search turn first."""
-    hidden = make_scenario("hidden", 0)
-    assert hidden.hidden and not hidden.target_visible(hidden.hidden[0].start)
-    for name in ("behind", "side"):
-        sc = make_scenario(name, 0)
-        x, y, heading = sc.start
-        tx, ty, _ = sc.target.position
-        bearing = math.degrees(math.atan2(ty - y, tx - x) - heading)
-        bearing = (bearing + 180) % 360 - 180
-        assert abs(bearing) > 60, (name, bearing)  # outside the 60-degree field of view at the start
-    for seed in WIND_SEEDS:
-        windy = make_scenario("ahead", seed, max_wind=WIND)
-        assert 0.0 < math.hypot(*windy.wind) <= WIND
-        assert make_scenario("ahead", seed).wind == (0.0, 0.0)
-    slow = sum(r.sim_seconds for r in flights[("hsv", "behind")]) / len(SEEDS)
-    fast = sum(r.sim_seconds for r in flights[("hsv", "ahead")]) / len(SEEDS)
-    assert slow > fast + 1.0  # the search turn costs time
+        assert r.final_state == "done", r.summary()
 
 
 def test_a_flight_is_deterministic_for_its_seed(virtual_drone: Path) -> None:
-    a = fly("distractor", 7, executable=virtual_drone)
-    b = fly("distractor", 7, executable=virtual_drone)
-    c = fly("distractor", 8, executable=virtual_drone)
+    a = fly("distractor", 7, executable=virtual_drone, max_seconds=12.0)
+    b = fly("distractor", 7, executable=virtual_drone, max_seconds=12.0)
+    c = fly("distractor", 8, executable=virtual_drone, max_seconds=12.0)
     key = ("frames_sent", "sim_seconds", "min_distance", "lit_on_target_ms", "reason")
     assert [getattr(a, k) for k in key] == [getattr(b, k) for k in key]
     assert [getattr(a, k) for k in key] != [getattr(c, k) for k in key]
@@ -136,3 +80,18 @@ def test_recording(virtual_drone: Path, tmp_path: Path) -> None:
     assert "result" in lines[-1]
     picture = cv2.imread(str(r.path_picture))
     assert picture is not None and picture.shape[0] > 300
+
+
+def test_the_scenarios_really_differ() -> None:
+    """Behind and side need a search turn; hidden covers the target; red_distractors has red things."""
+    hidden = make_scenario("hidden", 0)
+    assert hidden.hidden and not hidden.target_visible(hidden.hidden[0].start)
+    for name in ("behind", "side"):
+        sc = make_scenario(name, 0)
+        x, y, heading = sc.start
+        tx, ty, _ = sc.target.position
+        bearing = (math.degrees(math.atan2(ty - y, tx - x) - heading) + 180) % 360 - 180
+        assert abs(bearing) > 60, (name, bearing)  # outside the 60-degree field of view at the start
+    assert len(make_scenario("red_distractors", 0).distractors) >= 3
+    assert make_scenario("moving_target", 0).target_offset(4.0) != (0.0, 0.0)
+    assert make_scenario("ahead", 1, gusts=0.5).gusts == 0.5 and make_scenario("ahead", 1).wind == (0.0, 0.0)
