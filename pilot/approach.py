@@ -13,9 +13,10 @@ from collections import deque
 
 
 class ClosingSpeed:
-    def __init__(self, window_s: float = 0.4, min_samples: int = 4) -> None:
+    def __init__(self, window_s: float = 0.4, min_samples: int = 4, max_rate: float = 2.5) -> None:
         self.window_s = window_s
         self.min_samples = min_samples
+        self.max_rate = max_rate  # m/s between two samples that no flight reaches: a new target, start again
         self._samples: deque[tuple[float, float]] = deque()
 
     def reset(self) -> None:
@@ -24,6 +25,10 @@ class ClosingSpeed:
     def update(self, t: float, range_m: float) -> None:
         if range_m <= 0.0 or not math.isfinite(range_m):
             return
+        if self._samples:
+            t0, r0 = self._samples[-1]
+            if t <= t0 or abs(range_m - r0) > self.max_rate * (t - t0):
+                self._samples.clear()
         self._samples.append((t, range_m))
         while self._samples and t - self._samples[0][0] > self.window_s:
             self._samples.popleft()
@@ -46,3 +51,25 @@ class ClosingSpeed:
 def allowed_speed(remaining_m: float, brake_mps2: float, top_mps: float) -> float:
     """The closing speed from which the drone can still stop within ``remaining_m``."""
     return min(top_mps, math.sqrt(2.0 * brake_mps2 * max(0.0, remaining_m)))
+
+
+class Momentum:
+    """Dead reckoning of the forward speed from the pitch commands the pilot sent, for when vision has none (the
+    target lost while closing in): a pitch command of one speed step accelerates at ``accel_per_step``, and
+    with the stick released the speed decays with drag over ``decay_s``. Any vision estimate replaces it."""
+
+    def __init__(self, accel_per_step: float, decay_s: float = 3.0) -> None:
+        self.accel_per_step = accel_per_step
+        self.decay_s = decay_s
+        self.speed = 0.0  # m/s forward
+
+    def reset(self) -> None:
+        self.speed = 0.0
+
+    def observe(self, closing: float | None) -> None:
+        if closing is not None:
+            self.speed = closing
+
+    def advance(self, pitch_steps: float, dt: float) -> None:
+        """``pitch_steps``: the pitch stick held during ``dt``, in speed steps (forward positive)."""
+        self.speed += self.accel_per_step * pitch_steps * dt - self.speed * dt / self.decay_s

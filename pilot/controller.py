@@ -45,7 +45,7 @@ from collections.abc import Callable
 
 import drone_protocol as dp
 
-from .approach import ClosingSpeed, allowed_speed
+from .approach import ClosingSpeed, Momentum, allowed_speed
 from .config import ControllerConfig
 from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, speed_for
 from .detection import Detection
@@ -61,6 +61,10 @@ class Controller(ControllerCore):
         super().__init__(config, clock)
         self.gate = Gate(self.cfg)  # vision gate (issue 12): every sighting and every laser-on goes through it
         self.closing = ClosingSpeed()
+        self.momentum = Momentum(self.cfg.pitch_accel_mps2)
+        self._pitch_steps = 0.0  # the pitch stick the last command holds, in speed steps (forward positive)
+        self._pitch_until_ms = 0
+        self._last_ms = self._now()
         self._brake_until_ms = 0  # target lost while closing in: brake this long before searching
         self._brake_speed = 0.0
 
@@ -81,10 +85,39 @@ class Controller(ControllerCore):
         return self._emit(dp.move_backward(speed_for(dp.CommandName.MOVE_BACKWARD, frac)))
 
     def _decide(self, det: Detection | None) -> bytes | None:
+        now = self._now()
+        held = self._pitch_steps if now <= self._pitch_until_ms else 0.0
+        self.momentum.advance(held, (now - self._last_ms) / 1000.0)
+        self._last_ms = now
         if det is not None and det.found and self.state in LOCKED:
-            self.closing.update(self._now() / 1000.0, det.range_m)
-        elif self.state not in LOCKED:
+            self.closing.update(now / 1000.0, det.range_m)
+            self.momentum.observe(self.closing.closing)
+        elif self.state not in LOCKED and self.state is not State.SEARCH:
             self.closing.reset()
+            self.momentum.reset()
+        frame = self._decide_frame(det)
+        self._held_pitch(frame)
+        return frame
+
+    def _held_pitch(self, frame: bytes | None) -> None:
+        """What the firmware holds after this frame: a pitch command for its command timeout, any other
+        movement or a hold releases the pitch; a non-movement frame (servo, laser, status) changes nothing."""
+        if frame is None:
+            return
+        try:
+            command = dp.decode(frame)
+        except dp.ProtocolError:
+            return
+        channel = dp.COMMANDS[command.name].target
+        if channel == dp.ChannelName.PITCH.value:
+            median = dp.CHANNELS[dp.ChannelName.PITCH].median
+            sense = 1 if command.name is dp.CommandName.MOVE_FORWARD else -1
+            self._pitch_steps = sense * abs(int(command.value or median) - median) / dp.SPEED_STEP_US
+            self._pitch_until_ms = self._now() + dp.COMMAND_TIMEOUT_MS
+        elif channel in {c.value for c in dp.ChannelName} or command.name is dp.CommandName.HOLD_ALTITUDE:
+            self._pitch_steps = 0.0
+
+    def _decide_frame(self, det: Detection | None) -> bytes | None:
         # -- vision gate (issue 12): a bad frame holds (laser off), too many in a row land ------------
         self.gate.observe(det)
         if self.gate.fault is not None and self.state in FLYING - {State.TAKEOFF, State.HOLD}:
@@ -127,8 +160,8 @@ class Controller(ControllerCore):
         """Target lost: laser off first, then sticks neutral, then the servos home, then search; lost while
         closing in, the search starts by braking for as long as the last closing speed needs."""
         off = self._laser(False)
-        closing = self.closing.closing
-        if closing is not None and closing > 0.15:
+        closing = self.momentum.speed  # vision's last estimate, carried on by dead reckoning
+        if closing > 0.15:
             self._brake_until_ms = self._now() + round(1000.0 * closing / self.cfg.brake_mps2)
             self._brake_speed = closing
         self._go(State.SEARCH, reason)
@@ -164,6 +197,16 @@ class Controller(ControllerCore):
             return self._emit(dp.servo_reset())
         ex, ey, size = det.error_x, det.error_y, det.relative_size
         self._remember_side(det)
+        if size >= cfg.approach_size:  # close enough whatever else is off: AIM centres it with the servos
+            self._go(State.AIM, f"close enough (size {size:.3f})")
+            return self._on_aim(det)
+        closing, allowed = self.closing.closing, cfg.approach_speed_mps
+        if closing is not None and det.range_m > 0.0:
+            # the range still to go before the aim range (range scales as 1/size), and the speed allowed there
+            allowed = allowed_speed(det.range_m * (1.0 - size / cfg.approach_size), cfg.brake_mps2,
+                                    cfg.approach_speed_mps)
+            if closing > allowed + 0.15:  # braking comes before any other correction
+                return self._brake(closing - allowed)
         if abs(ex) > cfg.dead_band_x:
             frac = 0.35 + 0.65 * min(1.0, abs(ex) / 0.5)
             if ex > 0:
@@ -174,18 +217,8 @@ class Controller(ControllerCore):
             if ey < 0:
                 return self._emit(dp.move_up(speed_for(dp.CommandName.MOVE_UP, frac)))
             return self._emit(dp.move_down(speed_for(dp.CommandName.MOVE_DOWN, frac)))
-        if size >= cfg.approach_size:
-            self._go(State.AIM, f"close enough (size {size:.3f})")
-            return self._on_aim(det)
-        closing = self.closing.closing
-        if closing is not None and det.range_m > 0.0:
-            # the range still to go before the aim range (range scales as 1/size), and the speed allowed there
-            allowed = allowed_speed(det.range_m * (1.0 - size / cfg.approach_size), cfg.brake_mps2,
-                                    cfg.approach_speed_mps)
-            if closing > allowed + 0.15:
-                return self._brake(closing - allowed)
-            if closing > allowed - 0.1:
-                return self._emit(dp.hold_altitude())  # coasting at about the right speed
+        if closing is not None and closing > allowed - 0.1:
+            return self._emit(dp.hold_altitude())  # coasting at about the right speed
         frac = 1.8 if size < 0.45 * cfg.approach_size else (1.0 if size < 0.75 * cfg.approach_size else 0.6)
         self._coast = self._emit(dp.move_forward(speed_for(dp.CommandName.MOVE_FORWARD, frac)))
         return self._coast

@@ -52,7 +52,7 @@ def _run(job: FlightJob) -> dict[str, object]:
 def campaign(todo: list[FlightJob], processes: int) -> None:
     LOG.parent.mkdir(parents=True, exist_ok=True)
     LOG.write_text("")
-    ctx = multiprocessing.get_context("fork")
+    ctx = multiprocessing.get_context("spawn")  # a forked child would inherit MuJoCo's GL context
     with ctx.Pool(processes) as pool, LOG.open("a") as log:
         for n, row in enumerate(pool.imap_unordered(_run, todo, chunksize=1), 1):
             log.write(json.dumps(row) + "\n")

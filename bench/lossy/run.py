@@ -177,7 +177,7 @@ def fly(job: tuple[str, int, float, str, str]) -> FlightFigures:
 
 def campaign(exe: str, integrity: str, seeds: int, processes: int) -> list[FlightFigures]:
     jobs = [(SCENARIOS[s % len(SCENARIOS)], 1 + s, rate, integrity, exe) for rate in RATES for s in range(seeds)]
-    ctx = multiprocessing.get_context("fork")
+    ctx = multiprocessing.get_context("spawn")  # a forked child would inherit MuJoCo's GL context
     with ctx.Pool(processes) as pool:
         return pool.map(fly, jobs, chunksize=1)
 

@@ -24,7 +24,7 @@ from ..runner import Observer, run
 from .camera import CameraModel
 from .room import make_scenario
 from .virtual import VirtualDrone
-from .world import BOOT_MS, SimWorld
+from .world import BOOT_MS, CameraFault, SimWorld
 
 SUCCESS_LIT_MS = 500  # laser on the target, within reach, for at least this long
 
@@ -62,6 +62,8 @@ class FlightResult:
     render_ms: float = 0.0  # wall time in MuJoCo's renderer
     frames: int = 0
     non_target_what: tuple[str, ...] = ()
+    lit_during_fault_ms: int = 0  # laser on while the camera was faulty (a fault injected with ``fault``)
+    landed_because: str = ""  # the reason of the controller's move to LAND
 
     def summary(self) -> str:
         verdict = "reached and lit" if self.success else "FAILED"
@@ -87,6 +89,7 @@ class FlightJob:
     executable: str | None = None
     max_wind: float = 0.0
     gusts: float = 0.0
+    fault: str | None = None  # a camera fault, KIND@START+DURATION (world.CameraFault)
 
 
 def fly(
@@ -104,6 +107,7 @@ def fly(
     observers: Sequence[Observer] = (),
     max_wind: float = 0.0,
     gusts: float = 0.0,
+    fault: str | None = None,
 ) -> FlightResult:
     cfg = config or PilotConfig()
     if detector_name is not None:
@@ -123,6 +127,7 @@ def fly(
                 tick_ms=tick_ms,
                 aim_point="marker" if cfg.detector == "aruco" else "ball",
                 lose_camera_at_s=lose_camera_at_s,
+                fault=CameraFault.parse(fault) if fault else None,
             ) as world,
         ):
 
@@ -209,6 +214,8 @@ def fly(
                 render_ms=score.render_ms,
                 frames=score.frames,
                 non_target_what=tuple(score.non_target_what),
+                lit_during_fault_ms=score.lit_during_fault_ms,
+                landed_because=next((t.reason for t in controller.transitions if t.new is State.LAND), ""),
                 error=None if result.error is None else f"{type(result.error).__name__}: {result.error}",
             )
     finally:
@@ -227,6 +234,7 @@ def _fly_job(job: FlightJob) -> FlightResult:
         executable=job.executable,
         max_wind=job.max_wind,
         gusts=job.gusts,
+        fault=job.fault,
     )
 
 
@@ -235,6 +243,6 @@ def fly_many(jobs: Iterable[FlightJob], processes: int | None = None) -> list[Fl
     todo = list(jobs)
     if processes == 1 or len(todo) <= 1:
         return [_fly_job(job) for job in todo]
-    ctx = multiprocessing.get_context("fork")
+    ctx = multiprocessing.get_context("spawn")  # a forked child would inherit MuJoCo's GL context
     with ctx.Pool(processes or None) as pool:
         return pool.map(_fly_job, todo, chunksize=1)

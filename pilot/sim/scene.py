@@ -117,10 +117,12 @@ def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg
         w.materials.append('<material name="marker" texture="tex_marker" rgba="1 1 1 1" specular="0"/>')
         half = plate.side * 0.75
         f = plate.facing
+        # in front of the pole (radius 0.015): a pole across the marker's border would hide it from the detector
         target_geoms.append(_wall_plane("target_marker", 0.0, 0.0, plate.centre[2], f, (half, half), "marker",
-                                        offset=0.011))
-        target_geoms.append(f'<geom name="target_backing" type="box" pos="0 0 {plate.centre[2]:.4g}" '
-                            f'quat="{_yaw_quat(f)}" size="{_f(0.01, half, half)}" material="{pole}"/>')
+                                        offset=0.032))
+        bx, by = 0.022 * math.cos(f), 0.022 * math.sin(f)
+        target_geoms.append(f'<geom name="target_backing" type="box" pos="{_f(bx, by, plate.centre[2])}" '
+                            f'quat="{_yaw_quat(f)}" size="{_f(0.008, half, half)}" material="{pole}"/>')
     lights = [f'<light name="light_{i}" pos="{_f(*lt.position)}" dir="{_f(*lt.direction)}" '
               f'diffuse="{_f(*lt.rgb)}" specular="0.1 0.1 0.1" castshadow="false" attenuation="1 0 0"/>'
               for i, lt in enumerate(sc.lights)]

@@ -36,6 +36,7 @@ class FlightScore:
     lit_elsewhere_ms: int = 0  # laser on, its ray on anything else
     non_target_hits: int = 0  # times the laser came on (or moved) onto something that is not the target
     non_target_what: list[str] = field(default_factory=list)
+    lit_during_fault_ms: int = 0  # laser on while the camera was faulty
     min_distance: float = math.inf
     reached: bool = False  # came within reach
     path: list[tuple[float, float, float, float]] = field(default_factory=list)  # t, x, y, z
@@ -57,6 +58,7 @@ class SimWorld(Closing):
         aim_point: str = "ball",
         params: rc.SimParams | None = None,
         lose_camera_at_s: float | None = None,
+        fault: CameraFault | None = None,
     ) -> None:
         mujoco = mj.module()
         self.scenario = scenario
@@ -76,6 +78,7 @@ class SimWorld(Closing):
         self.reach_m = reach_m
         self.aim_point = aim_point
         self.lose_camera_at_s = lose_camera_at_s
+        self.fault = fault
         self.score = FlightScore()
         self._ray_groups = np.array([1 if g not in (DRONE_GROUP, HIDDEN_GROUP) else 0 for g in range(6)], np.uint8)
         wanted = "target_marker" if aim_point == "marker" and scenario.marker is not None else "target_ball"
@@ -168,6 +171,9 @@ class SimWorld(Closing):
         if not outputs.laser:
             self._last_hit = -1
             return
+        fault = self.fault
+        if fault is not None and fault.start_s <= self._t_ms / 1000.0 < fault.start_s + fault.duration_s:
+            score.lit_during_fault_ms += dt_ms
         hit = self.laser_hit()
         if hit == self._aim_geom and dist <= self.reach_m:
             score.lit_on_target_ms += dt_ms
@@ -190,12 +196,51 @@ class SimWorld(Closing):
             self.vd.close()
 
 
+@dataclass(frozen=True)
+class CameraFault:
+    """A camera that misbehaves from ``start_s`` for ``duration_s``: ``black``, ``saturated``, ``frozen`` (its
+    last good frame again), ``small`` (a frame of another size) or ``grey`` (one channel)."""
+
+    kind: str
+    start_s: float
+    duration_s: float
+
+    KINDS = ("black", "saturated", "frozen", "small", "grey")
+
+    @staticmethod
+    def parse(text: str) -> CameraFault:
+        """KIND@START+DURATION, seconds: ``black@8+3``."""
+        try:
+            kind, times = text.split("@")
+            start, duration = times.split("+")
+            fault = CameraFault(kind, float(start), float(duration))
+        except ValueError as exc:
+            raise SimulatorError(f"camera fault {text!r}: expected KIND@START+DURATION, e.g. black@8+3") from exc
+        if fault.kind not in CameraFault.KINDS or fault.start_s < 0 or fault.duration_s <= 0:
+            raise SimulatorError(f"camera fault {text!r}: kind one of {', '.join(CameraFault.KINDS)}, times >= 0")
+        return fault
+
+    def apply(self, t: float, image: Image, last: Image | None) -> Image:
+        if not self.start_s <= t < self.start_s + self.duration_s:
+            return image
+        if self.kind == "black":
+            return np.zeros_like(image)
+        if self.kind == "saturated":
+            return np.full_like(image, 255)
+        if self.kind == "frozen":
+            return last if last is not None else image
+        if self.kind == "small":
+            return np.ascontiguousarray(image[::2, ::2])
+        return np.ascontiguousarray(image[..., 1])  # grey: one channel
+
+
 class SimCamera(FrameSourceBase):
     """The frame source of the simulated room: the view from the drone's current pose."""
 
     def __init__(self, world: SimWorld) -> None:
         super().__init__(world.now)
         self.world = world
+        self._good: Image | None = None
 
     def read(self) -> Frame | None:
         w = self.world
@@ -203,4 +248,10 @@ class SimCamera(FrameSourceBase):
             raise FrameSourceError("simulated camera: read after close")
         if w.lose_camera_at_s is not None and w.now() >= w.lose_camera_at_s:
             raise FrameSourceError(f"simulated camera lost at t={w.now():.2f} s")
-        return self._frame(w.render())
+        image = w.render()
+        if w.fault is not None:
+            faulty = w.fault.apply(w.now(), image, self._good)
+            if faulty is image:
+                self._good = image
+            image = faulty
+        return self._frame(image)

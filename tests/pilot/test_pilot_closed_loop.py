@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from pilot.config import VisionConfig
 from pilot.sim.flight import SUCCESS_LIT_MS, FlightJob, FlightResult, fly, fly_many
 from pilot.sim.room import make_scenario
 
@@ -95,3 +96,23 @@ def test_the_scenarios_really_differ() -> None:
     assert len(make_scenario("red_distractors", 0).distractors) >= 3
     assert make_scenario("moving_target", 0).target_offset(4.0) != (0.0, 0.0)
     assert make_scenario("ahead", 1, gusts=0.5).gusts == 0.5 and make_scenario("ahead", 1).wind == (0.0, 0.0)
+
+
+# shorter than controller.blind_frames (20 frames, 1 s): the pilot holds through it
+@pytest.mark.parametrize("fault", ["black@12+0.6", "frozen@12+0.6", "small@12+0.6", "grey@12+0.6"])
+def test_a_short_camera_fault_holds_with_the_laser_off_then_the_flight_goes_on(virtual_drone: Path,
+                                                                                fault: str) -> None:
+    r = fly("ahead", SEED, executable=virtual_drone, fault=fault)
+    # off within one reply round trip of the first bad frame; a frozen camera is known only after
+    # vision.frozen_frames identical frames (its repeats look like good frames until then)
+    late = (VisionConfig().frozen_frames - 1) * 50 if fault.startswith("frozen") else 0
+    assert r.lit_during_fault_ms <= 100 + late, r.summary()
+    assert r.non_target_hits == 0 and r.wall_hits == 0 and r.crashes == 0, r.summary()
+    assert r.success, r.summary()
+
+
+def test_a_camera_that_stays_dark_lands_the_drone(virtual_drone: Path) -> None:
+    r = fly("ahead", SEED, executable=virtual_drone, fault="saturated@9+60")
+    assert r.landed_because == "camera: saturated frames", r.summary()
+    assert not r.success and r.lit_on_target_ms == 0 and r.lit_during_fault_ms == 0
+    assert not r.final_laser and not r.final_fc_armed and r.final_altitude < 0.02 and r.crashes == 0, r.summary()

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import math
 from pathlib import Path
 
 import cv2
@@ -12,15 +11,12 @@ import numpy as np
 import pilot_synth as synth
 import pytest
 import yaml
-from pilot.sim.model import DroneModel, Outputs, StickCentres
 
 from pilot import config as config_mod
 from pilot.calibrate import calibrate_to_config, hsv_ranges_from_sample
 from pilot.config import HsvConfig, PilotConfig
 from pilot.detect import HsvBlobDetector
 from pilot.errors import ConfigError, FrameSourceError
-from pilot.sim.camera import CameraModel, CameraPose, Renderer
-from pilot.sim.room import SCENARIOS, Room, make_scenario
 from pilot.sources import CameraSource, ImageFolderSource, VideoFileSource
 
 PAN0, TILT0 = dp.SERVOS[dp.ServoName.PAN].default, dp.SERVOS[dp.ServoName.TILT].default

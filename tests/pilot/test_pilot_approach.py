@@ -1,0 +1,77 @@
+"""The approach without position hold: the closing speed from the detector's ranges, braking, holding the
+range near the target, and braking by dead reckoning when the target is lost while closing in."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import drone_protocol as dp
+import pytest
+from test_pilot_controller import CFG, MISS, name, seen, st, to_state
+
+from pilot.approach import ClosingSpeed, allowed_speed
+from pilot.controller import State
+from pilot.detection import range_of
+
+W = 320
+
+
+def size_at(range_m: float) -> float:
+    """The relative apparent size of the 0.3 m ball at ``range_m`` (inverse of range_of)."""
+    lo, hi = 1.0, 400.0
+    for _ in range(60):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if range_of(mid, 0.3, W, CFG.horizontal_fov_deg) > range_m else (lo, mid)
+    return lo / W
+
+
+def test_closing_speed_is_the_slope_of_the_ranges() -> None:
+    est = ClosingSpeed()
+    assert est.closing is None
+    for k in range(10):
+        est.update(k * 0.05, 3.0 - 0.5 * k * 0.05)  # 0.5 m/s closer every second
+    assert est.closing == pytest.approx(0.5)
+    est.update(0.55, float("nan"))  # no range: ignored
+    assert est.closing == pytest.approx(0.5)
+    est.reset()
+    assert est.closing is None
+    assert allowed_speed(0.0, 0.5, 0.6) == 0.0 and allowed_speed(10.0, 0.5, 0.6) == 0.6
+
+
+def test_aim_brakes_a_closing_drone_and_nudges_a_receding_one() -> None:
+    c, rig = to_state(State.AIM, dataclasses.replace(CFG, aim_frames=100))  # stays aiming
+    r = 1.3
+    out = None
+    for _ in range(6):
+        r -= 0.05  # 1 m/s closer
+        out = rig.tick(seen(size=size_at(r)))
+    assert st(c) is State.AIM and name(out) == "move_backward"
+    c.closing.reset()
+    for _ in range(6):
+        r += 0.03  # 0.6 m/s away, still above the retreat size
+        out = rig.tick(seen(size=size_at(r)))
+    assert st(c) is State.AIM and name(out) == "move_forward"
+
+
+def test_track_coasts_or_brakes_when_closing_faster_than_it_can_stop() -> None:
+    c, rig = to_state(State.TRACK)
+    r = 2.2
+    outs = []
+    for _ in range(6):
+        r -= 0.1  # 2 m/s closer: far above what 0.5 m/s² stops before the aim range
+        outs.append(name(rig.tick(seen(size=size_at(r)))))
+    assert st(c) is State.TRACK and outs[-1] == "move_backward"
+
+
+def test_lost_while_closing_brakes_before_the_search_turns() -> None:
+    c, rig = to_state(State.TRACK)
+    r = 3.0
+    for _ in range(6):
+        r -= 0.04  # 0.8 m/s closer
+        rig.tick(seen(size=size_at(r)))
+    while st(c) is not State.SEARCH:
+        rig.tick(MISS)
+    assert name(rig.tick(MISS)) == "move_backward"  # braking first ...
+    turns = [name(rig.tick(MISS)) for _ in range(60)]
+    assert turns[-1] in ("turn_left", "turn_right")  # ... then the sweep
+    assert dp.COMMANDS[dp.CommandName.MOVE_BACKWARD].target == "pitch"
