@@ -22,6 +22,7 @@ import sys
 import time
 from collections import defaultdict
 from pathlib import Path
+from typing import Any
 
 from pilot.sim.flight import FlightJob, FlightResult, _fly_job
 from pilot.sim.room import SCENARIOS
@@ -41,7 +42,7 @@ def jobs(seeds: int, gust_seeds: int, executable: str | None) -> list[FlightJob]
     return out
 
 
-def _run(job: FlightJob) -> dict[str, object]:
+def _run(job: FlightJob) -> dict[str, Any]:
     result = _fly_job(job)
     row = dataclasses.asdict(result)
     row.pop("non_target_what")
@@ -60,27 +61,28 @@ def campaign(todo: list[FlightJob], processes: int) -> None:
             print(f"{n}/{len(todo)} {FlightResult.summary(_result(row))}", flush=True)
 
 
-def _result(row: dict[str, object]) -> FlightResult:
+def _result(row: dict[str, Any]) -> FlightResult:
     names = {f.name for f in dataclasses.fields(FlightResult)}
-    return FlightResult(**{k: v for k, v in row.items() if k in names})  # type: ignore[arg-type]
+    return FlightResult(**{k: v for k, v in row.items() if k in names})
 
 
 def _pct(n: int, d: int) -> str:
     return f"{n}/{d} ({100.0 * n / d:.1f} %)" if d else "0/0"
 
 
-def summarize(rows: list[dict[str, object]]) -> str:
-    groups: dict[str, list[dict[str, object]]] = defaultdict(list)
+def summarize(rows: list[dict[str, Any]]) -> str:
+    groups: dict[str, list[dict[str, Any]]] = defaultdict(list)
     for r in rows:
         groups[f"{r['detector']}{' + gusts' if r['gusts'] else ''}"].append(r)
     lines = ["| flights | reached and lit | non-target laser hits | wall hits (flights) | crashes | ended disarmed, "
              "laser off |", "|---|---|---|---|---|---|"]
     for name, rs in sorted(groups.items()):
+        results = [_result(r) for r in rs]
         lines.append(
-            f"| {name} | {_pct(sum(bool(r['success']) for r in rs), len(rs))} | "
-            f"{sum(int(r['non_target_hits']) for r in rs)} | {_pct(sum(int(r['wall_hits']) > 0 for r in rs), len(rs))} | "  # type: ignore[call-overload]
-            f"{sum(int(r['crashes']) > 0 for r in rs)} | "  # type: ignore[call-overload]
-            f"{_pct(sum(not r['final_laser'] and not r['final_fc_armed'] for r in rs), len(rs))} |")
+            f"| {name} | {_pct(sum(r.success for r in results), len(rs))} | "
+            f"{sum(r.non_target_hits for r in results)} | {_pct(sum(r.wall_hits > 0 for r in results), len(rs))} | "
+            f"{sum(r.crashes > 0 for r in results)} | "
+            f"{_pct(sum(not r.final_laser and not r.final_fc_armed for r in results), len(rs))} |")
     lines += ["", "Per scenario (reached and lit / flights):", "",
               "| scenario | " + " | ".join(sorted(groups)) + " |", "|---|" + "---|" * len(groups)]
     for name in SCENARIOS:
@@ -89,16 +91,16 @@ def summarize(rows: list[dict[str, object]]) -> str:
             rs = [r for r in groups[g] if r["scenario"] == name]
             cells.append(f"{sum(bool(r['success']) for r in rs)}/{len(rs)}")
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
-    what = sorted({w for r in rows for w in r["what"]})  # type: ignore[attr-defined]
+    what = sorted({w for r in rows for w in r["what"]})
     lines += ["", f"Non-target laser hits on: {', '.join(what) if what else 'nothing'}.", ""]
     lines += ["Simulator cost per 50 ms frame (one process per core; wall time):", "",
               "| frame | flights | physics + control (ms) | camera: render + sensor (ms) | real-time factor |",
               "|---|---|---|---|---|"]
-    for width in sorted({int(r["width"]) for r in rows}):  # type: ignore[call-overload]
+    for width in sorted({int(r["width"]) for r in rows}):
         rs = [r for r in rows if r["width"] == width]
-        frames = sum(int(r["frames"]) for r in rs) or 1  # type: ignore[call-overload]
-        phys = sum(float(r["physics_ms"]) for r in rs) / frames  # type: ignore[arg-type]
-        cam = sum(float(r["render_ms"]) for r in rs) / frames  # type: ignore[arg-type]
+        frames = sum(int(r["frames"]) for r in rs) or 1
+        phys = sum(float(r["physics_ms"]) for r in rs) / frames
+        cam = sum(float(r["render_ms"]) for r in rs) / frames
         lines.append(f"| {width}x{width * 3 // 4} | {len(rs)} | {phys:.2f} | {cam:.2f} | "
                      f"{TICK_S * 1000.0 / (phys + cam):.1f}x |")
     failed = [r for r in rows if not r["success"]]

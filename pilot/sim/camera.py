@@ -125,7 +125,7 @@ class Sensor:
         length = math.hypot(dx, dy)
         if length < 1.5:
             return None
-        size = int(math.ceil(length)) | 1
+        size = math.ceil(length) | 1
         kernel = np.zeros((size, size))
         c = size // 2
         cv2.line(kernel, (round(c - dx / 2), round(c - dy / 2)), (round(c + dx / 2), round(c + dy / 2)), 1.0, 1)

@@ -132,9 +132,9 @@ def load(parm: Path | None = REPO_PARM, overrides: Mapping[str, float] | None = 
         values |= _from_spec()
         source = "the codec's channel table (no parameter file)"
     values |= dict(overrides or {})
-    frame = data["airframe"]
-    airframe = Airframe(**{k: (tuple(float(x) for x in v) if isinstance(v, list) else float(v))
-                           for k, v in frame.items()})
+    frame: dict[str, Any] = {k: (tuple(float(x) for x in v) if isinstance(v, list) else float(v))
+                             for k, v in data["airframe"].items()}
+    airframe = Airframe(**frame)
     sticks: dict[str, Channel] = {}
     for name in STICKS:
         n = int(values.get(f"RCMAP_{name.upper()}", STICKS.index(name) + 1))

@@ -181,9 +181,7 @@ def _window(w: _Writer, sc: Scenario) -> str:
                       (room.depth - ty) / dy if dy > 0 else -ty / dy if dy < 0 else math.inf)]
     t = min(ts)
     x, y = tx + t * dx, ty + t * dy
-    if abs(t - ts[0]) < 1e-9:
-        heading = math.pi if dx > 0 else 0.0
-    else:
-        heading = -math.pi / 2 if dy > 0 else math.pi / 2
+    on_x_wall = abs(t - ts[0]) < 1e-9  # the line meets a wall of constant x first
+    heading = (math.pi if dx > 0 else 0.0) if on_x_wall else (-math.pi / 2 if dy > 0 else math.pi / 2)
     mat = w.colour_material("window", (1.0, 0.98, 0.92), emission=2.5)
     return _wall_plane("window", x, y, 1.6, heading, (1.0, 0.8), mat, offset=0.02)

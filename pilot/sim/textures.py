@@ -22,11 +22,11 @@ def photo(name: str, size: int = 256) -> bytes:
     img = np.asarray(getattr(skimage.data, name)())
     if img.ndim == 2:
         img = np.stack([img] * 3, axis=-1)
-    img = img[..., :3].astype(np.uint8)
-    h, w = img.shape[:2]
+    rgb: Image = np.asarray(img[..., :3], dtype=np.uint8)
+    h, w = rgb.shape[:2]
     scale = size / max(h, w)
-    img = cv2.resize(img, (max(8, round(w * scale)), max(8, round(h * scale))), interpolation=cv2.INTER_AREA)
-    return _png(img)
+    small = cv2.resize(rgb, (max(8, round(w * scale)), max(8, round(h * scale))), interpolation=cv2.INTER_AREA)
+    return _png(np.asarray(small, dtype=np.uint8))
 
 
 def marker(plate: MarkerPlate, cell_px: int = 16) -> bytes:

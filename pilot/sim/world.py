@@ -82,7 +82,7 @@ class SimWorld(Closing):
         self.score = FlightScore()
         self._ray_groups = np.array([1 if g not in (DRONE_GROUP, HIDDEN_GROUP) else 0 for g in range(6)], np.uint8)
         wanted = "target_marker" if aim_point == "marker" and scenario.marker is not None else "target_ball"
-        self._aim_geom = mujoco.mj_name2id(self.mj_model, mujoco.mjtObj.mjOBJ_GEOM, wanted)
+        self._aim_geom = int(mujoco.mj_name2id(self.mj_model, mujoco.mjtObj.mjOBJ_GEOM, wanted))
         self._last_hit = -1
         changes = vd.step(BOOT_MS)
         if vd.outputs is None:

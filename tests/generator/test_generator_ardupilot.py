@@ -61,6 +61,9 @@ def expected(spec: dict[str, Any]) -> dict[str, float]:
         n = order.index(name) + 1
         channel = dp.CHANNELS[name]
         want |= {f"RC{n}_MIN": channel.minimum, f"RC{n}_MAX": channel.maximum, f"RC{n}_TRIM": channel.median}
+    for name in spec.get("flight_controller", {}).get("reversed", []):
+        want[f"RC{order.index(name) + 1}_REVERSED"] = 1
+    want["THR_DZ"] = spec.get("flight_controller", {}).get("throttle_dead_band", 100)  # ArduCopter's default
     modes = spec["flight_modes"]
     want |= {"FS_THR_ENABLE": 3, "FLTMODE_CH": order.index("mode") + 1,
              f"FLTMODE{slot(modes['stabilize_us'])}": 0, f"FLTMODE{slot(modes['alt_hold_us'])}": 2}
@@ -142,3 +145,32 @@ def test_wiring_and_mode_mistakes_are_reported_where_they_are(tmp_path: Path, ed
     lines = run.stderr.splitlines()
     assert lines[0] == f"{spec}: 1 error; nothing was written", run.stderr
     assert lines[1].startswith(f"{spec}:{h.location(text, anchor)}: {message}"), lines[1]
+
+
+def test_without_a_flight_controller_section_the_parameters_keep_arducopters_defaults(tmp_path: Path) -> None:
+    text = h.spec_text()
+    start = text.index("# How ArduCopter must read the sticks")
+    end = text.index("throttle_dead_band: 10\n") + len("throttle_dead_band: 10\n")
+    spec = tmp_path / "drone.yaml"
+    spec.write_text(text[:start] + text[end:], encoding="utf-8")
+    run = h.generate("--spec", spec, "--out", tmp_path / "out")
+    assert run.code == 0, run.stderr
+    params = strict_parse((tmp_path / "out" / "ardupilot" / "drone.parm").read_text(encoding="utf-8"))
+    assert params["THR_DZ"][0] == 100 and not any(name.endswith("_REVERSED") for name in params)
+
+
+@pytest.mark.parametrize("edit,message", [
+    (("reversed: [pitch]", "reversed: [pitch, wings]"), "flight_controller.reversed: 'wings' is not a channel"),
+    (("reversed: [pitch]", "reversed: [pitch, pitch]"), "flight_controller.reversed: 'pitch' listed twice"),
+    (("reversed: [pitch]", "reversed: pitch"), "flight_controller.reversed: expected a list of channel names"),
+    (("throttle_dead_band: 10", "throttle_dead_band: 301"),
+     "flight_controller.throttle_dead_band: throttle_dead_band 301 is not in 0..300"),
+    (("throttle_dead_band: 10", "throttle_dead_bnd: 10"), "flight_controller.throttle_dead_bnd: unknown key"),
+])
+def test_a_bad_flight_controller_section_is_rejected_where_it_is(tmp_path: Path, edit: tuple[str, str],
+                                                                 message: str) -> None:
+    run, text, spec = generate(tmp_path, edit)
+    assert run.code == 2, run.stdout
+    line = h.location(text, edit[1]).split(":")[0]
+    assert f"{spec}:{line}:" in run.stderr and message in run.stderr, run.stderr
+    assert "Traceback" not in run.stderr and not (tmp_path / "out").exists()

@@ -173,7 +173,7 @@ CASES = [
             (("ready_timeout_ms: ^100000", "link.ready_timeout_ms: READY_TIMEOUT_MS = 100000 does not fit"),)),
     Hostile("arming hold past uint16_t", edited(("  arming_hold_ms: 2000", "  arming_hold_ms: 100000")),
             (("arming_hold_ms: ^100000", "safety.arming_hold_ms: ARMING_HOLD_MS = 100000 does not fit"),)),
-    Hostile("landing time past uint16_t", edited(("  landing_ms: 4000", "  landing_ms: 65536")),
+    Hostile("landing time past uint16_t", edited(("  landing_ms: 6000", "  landing_ms: 65536")),
             (("landing_ms: ^65536", "safety.landing_ms: LANDING_MS = 65536 does not fit"),)),
     Hostile("flight mode pulse past uint16_t", edited(("  alt_hold_us: 1425", "  alt_hold_us: 99999")),
             (("alt_hold_us: ^99999", "flight_modes.alt_hold_us: MODE_ALT_HOLD_US = 99999 does not fit"),)),
