@@ -71,6 +71,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scenario", choices=SCENARIOS, default="ahead", help="simulated scenario (default ahead)")
     p.add_argument("--max-seconds", type=float, default=60.0, help="flight time limit, seconds (default 60)")
     p.add_argument("--wind", type=float, default=0.0, help="simulated steady wind, up to this many m/s (default 0)")
+    p.add_argument("--gusts", type=float, default=0.0, help="simulated gusts of about this many m/s (default 0)")
+    p.add_argument("--camera-fault", metavar="KIND@START+SECONDS",
+                   help="simulated camera fault: black, saturated, frozen, small or grey, e.g. black@8+3")
     p.add_argument("--size", default="320x240", help="simulated camera frame size (default 320x240)")
     p.add_argument("--virtual-drone", help="the virtual drone executable (default: the firmware's host build)")
     p.add_argument("--no-status", action="store_true", help="no status line")
@@ -112,12 +115,20 @@ def _check_args(args: argparse.Namespace) -> None:
     checks = (
         ("--max-seconds", args.max_seconds, 0.0 < args.max_seconds <= 86_400.0, "above 0 and at most 86400"),
         ("--wind", args.wind, 0.0 <= args.wind <= 50.0, "within 0..50"),
+        ("--gusts", args.gusts, 0.0 <= args.gusts <= 20.0, "within 0..20"),
         ("--baud", args.baud, 0 < args.baud <= 4_000_000, "within 1..4000000"),
     )
     for option, value, ok, allowed in checks:
         if not ok:  # NaN fails every comparison, infinities the upper bounds
             raise PilotError(f"option {option} must be {allowed}, got {value!r}")
     _size(args.size)
+    if args.camera_fault is not None:
+        from .sim.world import CameraFault  # the simulator's own check (MuJoCo is not imported by this)
+
+        try:
+            CameraFault.parse(args.camera_fault)
+        except PilotError as exc:
+            raise PilotError(f"option --camera-fault: {exc}") from exc
 
 
 def _roi(text: str | None) -> Roi | None:
@@ -212,6 +223,8 @@ def _fly_sim_with(args: argparse.Namespace, cfg: PilotConfig, observers: list[Ob
         executable=args.virtual_drone,
         observers=observers,
         max_wind=args.wind,
+        gusts=args.gusts,
+        fault=args.camera_fault,
     )
 
 

@@ -5,7 +5,8 @@
    as a ratio (target: at most 2x); the ArUco detector for reference.
 2. Latency from a frame's arrival to its command's last byte written (and flushed) to the serial
    port: the real pilot loop flying the simulated room, the virtual drone on a pseudo-terminal.
-3. Simulated flights per minute: the closed-loop flights, one process and a pool of two.
+
+The closed-loop campaign (success rates, crashes, the simulator's own speed) is bench/flight.
 """
 
 from __future__ import annotations
@@ -25,8 +26,8 @@ from pilot.config import HsvConfig
 from pilot.detect import ArucoMarkerDetector, HsvBlobDetector
 from pilot.runner import Tick
 from pilot.sim.camera import CameraModel
-from pilot.sim.flight import FlightJob, fly, fly_many
-from pilot.sim.room import SCENARIOS, make_scenario
+from pilot.sim.flight import fly
+from pilot.sim.room import make_scenario
 from pilot.sim.still import StillView
 
 HERE = Path(__file__).resolve().parent
@@ -109,23 +110,6 @@ def bench_latency(seeds: int) -> list[str]:
     return rows
 
 
-def bench_flights(seeds: int) -> list[str]:
-    jobs = [FlightJob(name, seed) for name in SCENARIOS for seed in range(seeds)]
-    rows = ["| processes | flights | simulated s | wall s | flights/min | sim speed-up |", "|---|---|---|---|---|---|"]
-    for processes in (1, 2):
-        t0 = time.perf_counter()
-        results = fly_many(jobs, processes=processes)
-        wall = time.perf_counter() - t0
-        sim = sum(r.sim_seconds for r in results)
-        ok = sum(r.success for r in results)
-        assert ok >= 0.9 * len(results), f"only {ok}/{len(results)} flights succeeded"
-        rows.append(
-            f"| {processes} | {len(results)} | {sim:.0f} | {wall:.1f} | {len(results) / wall * 60:.0f} | "
-            f"{sim / wall:.0f}x |"
-        )
-    return rows
-
-
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__)
     p.add_argument("--quick", action="store_true", help="fewer repetitions")
@@ -149,9 +133,8 @@ def main(argv: list[str] | None = None) -> int:
         "",
         *bench_latency(seeds),
         "",
-        "## Simulated flights (closed loop, stepped clock; 7 scenarios x seeds)",
-        "",
-        *bench_flights(seeds),
+        "The closed-loop campaign in the MuJoCo simulator (success, crashes, the simulator's speed) is "
+        "`make bench-flight`: bench/flight/RESULTS.md.",
         "",
     ]
     text = "\n".join(sections)

@@ -3,7 +3,8 @@
 The mount sits on the airframe's nose and moves with it (lean, turn); the firmware's pan/tilt servo outputs
 turn it (at the spec's default angles it looks straight ahead along the airframe). The laser shares the
 camera's optical axis. Each frame: MuJoCo's offscreen render, then the sensor: auto-exposure, motion blur from
-the camera's actual angular rate over the exposure time, Gaussian noise scaled by the gain, JPEG compression.
+the camera's actual angular rate over the exposure time, Gaussian noise growing with the gain (drawn once per
+seed and cycled), JPEG compression.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ from .room import Scenario
 Image = npt.NDArray[np.uint8]
 FloatArray = npt.NDArray[np.float64]
 # the camera frame in the airframe's (x forward, y left, z up): MuJoCo cameras look along their -z, y up
+NOISE_GAINS = (1.0, 2.0, 4.0)
+NOISE_FRAMES = 4
 _LOOK_AHEAD = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
 
@@ -64,10 +67,27 @@ class Sensor:
         self.cam_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, "eye")
         self.renderer = mujoco.Renderer(model, camera.height, camera.width)
         self.gain = 1.0
-        self._rng = np.random.default_rng([scenario.seed, 0x5EED])
+        self._noise = self._noise_frames(np.random.default_rng([scenario.seed, 0x5EED]))
+        self._frame_count = 0
         self._last_axis: FloatArray | None = None
         self._last_t = 0.0
         self.render_ms = 0.0  # time in MuJoCo's renderer for the last frame (the simulator's figures)
+
+    def _noise_frames(self, rng: np.random.Generator) -> dict[float, list[tuple[Image, Image]]]:
+        """Sensor noise drawn once per seed (drawing it per frame costs more than MuJoCo's render): for gains of
+        1, 2 and 4 (its sigma grows as the gain's square root), NOISE_FRAMES frames each, as the positive and
+        the negative part for OpenCV's saturating add and subtract."""
+        if self.sc.noise_sigma <= 0.0:
+            return {}
+        shape = (self.cam.height, self.cam.width, 3)
+        out: dict[float, list[tuple[Image, Image]]] = {}
+        for gain in NOISE_GAINS:
+            frames = []
+            for _ in range(NOISE_FRAMES):
+                n = rng.normal(0.0, self.sc.noise_sigma * math.sqrt(gain), shape)
+                frames.append((np.clip(n, 0, 255).astype(np.uint8), np.clip(-n, 0, 255).astype(np.uint8)))
+            out[gain] = frames
+        return out
 
     def aim(self, pan_deg: float, tilt_deg: float) -> None:
         mujoco = mj.module()
@@ -102,9 +122,11 @@ class Sensor:
             out = np.asarray(cv2.filter2D(out, -1, blur), dtype=np.uint8)
         if abs(self.gain - 1.0) > 1e-3:
             out = np.asarray(cv2.convertScaleAbs(out, alpha=self.gain, beta=0.0), dtype=np.uint8)
-        if sc.noise_sigma > 0.0:
-            noise = self._rng.normal(0.0, sc.noise_sigma * math.sqrt(self.gain), out.shape).astype(np.int16)
-            out = np.clip(out.astype(np.int16) + noise, 0, 255).astype(np.uint8)
+        if self._noise:
+            nearest = min(NOISE_GAINS, key=lambda g: abs(math.log(g / self.gain)))
+            pos, neg = self._noise[nearest][self._frame_count % NOISE_FRAMES]
+            out = np.asarray(cv2.subtract(cv2.add(out, pos), neg), dtype=np.uint8)
+        self._frame_count += 1
         ok, data = cv2.imencode(".jpg", out, [cv2.IMWRITE_JPEG_QUALITY, sc.jpeg_quality])
         if ok:
             out = np.asarray(cv2.imdecode(data, cv2.IMREAD_COLOR), dtype=np.uint8)

@@ -180,3 +180,16 @@ def test_a_hidden_target_leaves_the_view_and_the_laser_path() -> None:
     assert all(rig.model.geom_group[g] == 0 for g in rig.af.target_geoms)
     rig.run(0.2)
     assert rig.af.target_geoms and all(rig.model.geom_group[g] == HIDDEN_GROUP for g in rig.af.target_geoms)
+
+
+def test_the_flying_pilot_never_imports_the_simulator() -> None:
+    """The command line (which names the scenarios) loads neither MuJoCo nor the simulator's photographs."""
+    import subprocess
+    import sys
+
+    code = ("import sys, pilot.cli, pilot.runner, pilot.link, pilot.controller; "
+            "bad = [m for m in sys.modules if m.split('.')[0] in ('mujoco', 'skimage') "
+            "or m in ('pilot.sim.world', 'pilot.sim.physics', 'pilot.sim.camera', 'pilot.sim.scene')]; "
+            "print(bad); sys.exit(1 if bad else 0)")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert run.returncode == 0, run.stdout + run.stderr
