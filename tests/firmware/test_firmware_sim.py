@@ -150,7 +150,8 @@ def test_every_valid_vector_gives_its_pulses_and_reply() -> None:
     plan.check(model.widths(), model.laser, [fw.R.accepted(init["land"])], "il")
     for k in range(1, (fw.SPEC.landing_ms + dp.ARMING_HOLD_MS) // 300 + 1):
         plan.send(init["land"], dt=300.0 * k)  # il0000 is the keep-alive while landing
-    plan.wait(fw.SPEC.landing_ms + 150)
+    # the check window opens just before the first keep-alive of the disarm sequence (one every 300 ms)
+    plan.wait((fw.SPEC.landing_ms // 300 + 1) * 300 - 30)
     model.sticks = {**fw.on_ground(), "yaw": dp.CHANNELS[dp.ChannelName.YAW].minimum}  # then the disarm sequence
     model.mode = dp.MODE_STABILIZE_US
     model.laser = False
