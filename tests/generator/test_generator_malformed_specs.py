@@ -72,8 +72,8 @@ CASES = [
          (("sens: 1", "categories.s.directions.u.sens: unknown key 'sens' (hint: did you mean 'sense'?)"),)),
     Case("unknown top-level key lists the known ones", (("# Tables 1, 2, 3, 5 and 6.\n", "notes: hello\n"),),
          (("notes: hello", "notes: unknown key 'notes' (hint: known keys: categories, channels, errors, fields, "
-           "flight_controller, flight_modes, frame, link, project, protocol, replies, safety, servos, settled, speeds, status, "
-           "wiring)"),)),
+           "flight_controller, flight_modes, frame, link, project, protocol, replies, safety, servos, settled, "
+           "speeds, status, wiring)"),)),
     Case("missing key", (("        name: backward\n", ""),),
          (("description: Backward", "categories.m.directions.b.name: missing key 'name'"),)),
     Case("missing key of a category: no field for its directions",
