@@ -73,7 +73,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--wind", type=float, default=0.0, help="simulated steady wind, up to this many m/s (default 0)")
     p.add_argument("--gusts", type=float, default=0.0, help="simulated gusts of about this many m/s (default 0)")
     p.add_argument("--camera-fault", metavar="KIND@START+SECONDS",
-                   help="simulated camera fault: black, saturated, frozen, small or grey, e.g. black@8+3")
+                   help="simulated camera fault: black, saturated, frozen, small or grey, from START seconds "
+                        "(or 'fire': when the laser first comes on), e.g. black@8+3")
     p.add_argument("--size", default="320x240", help="simulated camera frame size (default 320x240)")
     p.add_argument("--virtual-drone", help="the virtual drone executable (default: the firmware's host build)")
     p.add_argument("--no-status", action="store_true", help="no status line")

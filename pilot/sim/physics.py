@@ -22,6 +22,7 @@ from .room import Scenario
 from .scene import HIDDEN_GROUP, MOTOR_SPIN, motor_positions
 
 FloatArray = npt.NDArray[np.float64]
+HIT_GAP_S = 0.5
 
 
 @dataclass
@@ -72,6 +73,7 @@ class Airframe:
         self._hidden = False
         self._on_floor = True
         self._tipped = False
+        self._last_touch_t = -1.0
         self._gust = np.zeros(2)
         self._rng = np.random.default_rng([scenario.seed, 0x6057])
         self.t = 0.0
@@ -160,13 +162,15 @@ class Airframe:
                 if -float(d.qvel[2]) > self.frame.crash_speed and not self._on_floor:
                     st.crashes += 1
                 continue
-            if not st.touching and not touching:
+            # one hit per touch: a bouncing contact (on and off within HIT_GAP_S) is the same touch
+            if not st.touching and not touching and self.t - self._last_touch_t > HIT_GAP_S:
                 name = mj.module().mj_id2name(self.model, mj.module().mjtObj.mjOBJ_GEOM, other) or "?"
                 st.hit_what.append(f"{name} at {self.t:.1f} s")
+                st.wall_hits += 1
             touching = True
         self._on_floor = any(self.floor in (int(d.contact[i].geom1), int(d.contact[i].geom2)) for i in range(d.ncon))
-        if touching and not st.touching:
-            st.wall_hits += 1
+        if touching:
+            self._last_touch_t = self.t
         st.touching = touching
 
     def _update_state(self) -> None:

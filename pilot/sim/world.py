@@ -79,6 +79,7 @@ class SimWorld(Closing):
         self.aim_point = aim_point
         self.lose_camera_at_s = lose_camera_at_s
         self.fault = fault
+        self.fault_start = None if fault is None or fault.start_s < 0 else fault.start_s
         self.score = FlightScore()
         self._ray_groups = np.array([1 if g not in (DRONE_GROUP, HIDDEN_GROUP) else 0 for g in range(6)], np.uint8)
         wanted = "target_marker" if aim_point == "marker" and scenario.marker is not None else "target_ball"
@@ -172,7 +173,9 @@ class SimWorld(Closing):
             self._last_hit = -1
             return
         fault = self.fault
-        if fault is not None and fault.start_s <= self._t_ms / 1000.0 < fault.start_s + fault.duration_s:
+        if fault is not None and self.fault_start is None:
+            self.fault_start = self._t_ms / 1000.0  # a fault that starts with the laser
+        if fault is not None and fault.active(self._t_ms / 1000.0, self.fault_start):
             score.lit_during_fault_ms += dt_ms
         hit = self.laser_hit()
         if hit == self._aim_geom and dist <= self.reach_m:
@@ -198,8 +201,9 @@ class SimWorld(Closing):
 
 @dataclass(frozen=True)
 class CameraFault:
-    """A camera that misbehaves from ``start_s`` for ``duration_s``: ``black``, ``saturated``, ``frozen`` (its
-    last good frame again), ``small`` (a frame of another size) or ``grey`` (one channel)."""
+    """A camera that misbehaves from ``start_s`` (or, when it is negative, from the moment the laser first comes on)
+    for ``duration_s``: ``black``, ``saturated``, ``frozen`` (its last good frame again), ``small`` (a frame of
+    another size) or ``grey`` (one channel)."""
 
     kind: str
     start_s: float
@@ -209,19 +213,24 @@ class CameraFault:
 
     @staticmethod
     def parse(text: str) -> CameraFault:
-        """KIND@START+DURATION, seconds: ``black@8+3``."""
+        """KIND@START+DURATION, seconds: ``black@8+3``; START ``fire``: when the laser first comes on."""
         try:
             kind, times = text.split("@")
             start, duration = times.split("+")
-            fault = CameraFault(kind, float(start), float(duration))
+            fault = CameraFault(kind, -1.0 if start == "fire" else float(start), float(duration))
         except ValueError as exc:
             raise SimulatorError(f"camera fault {text!r}: expected KIND@START+DURATION, e.g. black@8+3") from exc
-        if fault.kind not in CameraFault.KINDS or fault.start_s < 0 or fault.duration_s <= 0:
-            raise SimulatorError(f"camera fault {text!r}: kind one of {', '.join(CameraFault.KINDS)}, times >= 0")
+        if fault.kind not in CameraFault.KINDS or not math.isfinite(fault.start_s) or fault.duration_s <= 0:
+            raise SimulatorError(f"camera fault {text!r}: kind one of {', '.join(CameraFault.KINDS)}, "
+                                 "START seconds or 'fire', DURATION above 0")
         return fault
 
-    def apply(self, t: float, image: Image, last: Image | None) -> Image:
-        if not self.start_s <= t < self.start_s + self.duration_s:
+    def active(self, t: float, start: float | None) -> bool:
+        """``start``: when it began (``start_s``, or the laser's first on; None: not yet)."""
+        return start is not None and start <= t < start + self.duration_s
+
+    def apply(self, t: float, start: float | None, image: Image, last: Image | None) -> Image:
+        if not self.active(t, start):
             return image
         if self.kind == "black":
             return np.zeros_like(image)
@@ -250,7 +259,7 @@ class SimCamera(FrameSourceBase):
             raise FrameSourceError(f"simulated camera lost at t={w.now():.2f} s")
         image = w.render()
         if w.fault is not None:
-            faulty = w.fault.apply(w.now(), image, self._good)
+            faulty = w.fault.apply(w.now(), w.fault_start, image, self._good)
             if faulty is image:
                 self._good = image
             image = faulty
