@@ -22,6 +22,8 @@ import enum
 import math
 from dataclasses import dataclass
 
+import drone_protocol as dp
+
 from .rc import ANGLE_RANGE, THROTTLE_RANGE, SimParams
 
 GRAVITY = 9.81
@@ -59,7 +61,7 @@ class Demand:
 def desired_climb_rate(params: SimParams, throttle: float) -> float:
     """AltHold's climb rate (m/s) for a throttle of 0..1000 (Copter::get_pilot_desired_climb_rate); mid-stick is
     the throttle's value halfway between its minimum and maximum (RC_Channel::get_control_mid)."""
-    ch = params.sticks["throttle"]
+    ch = params.sticks[dp.ChannelName.THROTTLE]
     mid = ch.range((ch.minimum + ch.maximum) / 2.0)
     dz = params["THR_DZ"]
     top, bottom = mid + dz, mid - dz
@@ -146,8 +148,9 @@ class FlightController:
         """``pulses``: roll, pitch, throttle, yaw and flight-mode pulse widths (µs)."""
         roll_pwm, pitch_pwm, throttle_pwm, yaw_pwm, mode_pwm = pulses
         sticks = self.p.sticks
-        roll_in, pitch_in = sticks["roll"].angle(roll_pwm), sticks["pitch"].angle(pitch_pwm)
-        yaw_in, throttle = sticks["yaw"].angle(yaw_pwm), sticks["throttle"].range(throttle_pwm)
+        roll_in, pitch_in = sticks[dp.ChannelName.ROLL].angle(roll_pwm), sticks[dp.ChannelName.PITCH].angle(pitch_pwm)
+        yaw_in = sticks[dp.ChannelName.YAW].angle(yaw_pwm)
+        throttle = sticks[dp.ChannelName.THROTTLE].range(throttle_pwm)
         self._modes(mode_pwm, throttle_pwm)
         self._arming(throttle <= 0.0, yaw_in, dt)
         if not self.armed:

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import drone_protocol as dp
 import yaml
 
 from ..errors import ConfigError
@@ -22,7 +23,7 @@ from ..errors import ConfigError
 HERE = Path(__file__).resolve().parent
 PARAMS_YAML = HERE / "arducopter.yaml"
 REPO_PARM = HERE.parents[1] / "generated" / "ardupilot" / "drone.parm"
-STICKS = ("roll", "pitch", "throttle", "yaw")
+STICKS = (dp.ChannelName.ROLL, dp.ChannelName.PITCH, dp.ChannelName.THROTTLE, dp.ChannelName.YAW)
 MODE_SLOT_BOUNDS_US = (1230, 1360, 1490, 1620, 1749)  # ArduPilot's read_6pos_switch
 ANGLE_RANGE = 4500.0
 THROTTLE_RANGE = 1000.0
@@ -81,7 +82,7 @@ class Channel:
 class SimParams:
     values: Mapping[str, float]  # ArduCopter's parameters by name
     airframe: Airframe
-    sticks: Mapping[str, Channel]  # roll, pitch, throttle, yaw
+    sticks: Mapping[dp.ChannelName, Channel]  # roll, pitch, throttle, yaw
     source: str  # where the RC setup came from
 
     def __getitem__(self, name: str) -> float:
@@ -112,12 +113,10 @@ def read_parm(path: Path) -> dict[str, float]:
 
 def _from_spec() -> dict[str, float]:
     """Without a parameter file: the RC ranges from the codec's tables (the spec's recorded extremes)."""
-    import drone_protocol as dp
-
     out: dict[str, float] = {}
     for n, name in enumerate(STICKS, 1):
-        ch = dp.CHANNELS[dp.ChannelName(name)]
-        out |= {f"RCMAP_{name.upper()}": n, f"RC{n}_MIN": ch.minimum, f"RC{n}_MAX": ch.maximum,
+        ch = dp.CHANNELS[name]
+        out |= {f"RCMAP_{name.value.upper()}": n, f"RC{n}_MIN": ch.minimum, f"RC{n}_MAX": ch.maximum,
                 f"RC{n}_TRIM": ch.median}
     return out
 
@@ -135,14 +134,14 @@ def load(parm: Path | None = REPO_PARM, overrides: Mapping[str, float] | None = 
     frame: dict[str, Any] = {k: (tuple(float(x) for x in v) if isinstance(v, list) else float(v))
                              for k, v in data["airframe"].items()}
     airframe = Airframe(**frame)
-    sticks: dict[str, Channel] = {}
+    sticks: dict[dp.ChannelName, Channel] = {}
     for name in STICKS:
-        n = int(values.get(f"RCMAP_{name.upper()}", STICKS.index(name) + 1))
+        n = int(values.get(f"RCMAP_{name.value.upper()}", STICKS.index(name) + 1))
         try:
             lo, hi = values[f"RC{n}_MIN"], values[f"RC{n}_MAX"]
         except KeyError as exc:
-            raise ConfigError(f"simulator parameters: no {exc.args[0]} for the {name} input") from exc
+            raise ConfigError(f"simulator parameters: no {exc.args[0]} for the {name.value} input") from exc
         trim = values.get(f"RC{n}_TRIM", (lo + hi) / 2.0)
-        dz = values["RC3_DZ"] if name == "throttle" else values["RC_DZ"]
+        dz = values["RC3_DZ"] if name is dp.ChannelName.THROTTLE else values["RC_DZ"]
         sticks[name] = Channel(lo, hi, trim, bool(values.get(f"RC{n}_REVERSED", 0)), dz)
     return SimParams(values, airframe, sticks, source)

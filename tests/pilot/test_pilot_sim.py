@@ -52,7 +52,7 @@ class Rig:
 
 def test_parameters_come_from_the_generated_file() -> None:
     assert PARAMS.source.endswith("drone.parm")
-    assert PARAMS.sticks["pitch"].reversed  # the spec's flight_controller.reversed
+    assert PARAMS.sticks[dp.ChannelName.PITCH].reversed  # the spec's flight_controller.reversed
     assert PARAMS["THR_DZ"] < 100  # the spec's dead band, not ArduCopter's default
     assert PARAMS.mode_number(ALT_HOLD) == 2 and PARAMS.mode_number(STABILIZE) == 0
 
@@ -94,13 +94,13 @@ def test_mapping_yaw_stick_is_a_rate_up_to_pilot_y_rate() -> None:
 
 def test_mapping_throttle_is_a_climb_rate_with_a_dead_band() -> None:
     mid = MEDIANS["throttle"]
-    assert desired_climb_rate(PARAMS, PARAMS.sticks["throttle"].range(mid)) == 0.0
+    assert desired_climb_rate(PARAMS, PARAMS.sticks[dp.ChannelName.THROTTLE].range(mid)) == 0.0
     assert desired_climb_rate(PARAMS, 1000.0) == pytest.approx(PARAMS["PILOT_SPEED_UP"] / 100.0)
     rig = Rig().airborne()
     z0 = rig.af.state.z
     rig.run(2.0)  # centred: the altitude is held
     assert rig.af.state.z == pytest.approx(z0, abs=0.05)
-    want = desired_climb_rate(PARAMS, PARAMS.sticks["throttle"].range(CH["throttle"].high))
+    want = desired_climb_rate(PARAMS, PARAMS.sticks[dp.ChannelName.THROTTLE].range(CH["throttle"].high))
     assert want > 0.3  # the spec's speed step is outside the dead band
     rig.run(1.0, throttle=CH["throttle"].high)
     z1 = rig.af.state.z
