@@ -11,7 +11,8 @@ height, and returns four motor thrusts. What it reproduces, with ArduCopter's pa
   ``PILOT_SPEED_DN`` with ``PILOT_ACCEL_Z``, and the altitude held when centred;
 * arming with throttle at zero and yaw right held ``ARM_DELAY_S``; disarming likewise with yaw left, landed only;
 * radio failsafe (throttle below ``FS_THR_VALUE``): disarm when landed, else Land (RTL falls back to Land
-  indoors without GPS) at ``LAND_SPEED``, and disarm on touchdown.
+  indoors without GPS) at ``LAND_SPEED``, and disarm on touchdown;
+* the crash check: an attitude off its target by more than 30° for 2 s disarms.
 
 Angles here are ArduCopter's (roll right, pitch nose-up and yaw clockwise positive); ``physics.py`` converts.
 """
@@ -104,6 +105,7 @@ class FlightController:
         self._arm_timer = 0.0
         self._disarm_timer = 0.0
         self._land_timer = 0.0
+        self._crash_timer = 0.0
         self._mode_pwm = -1.0
         self._climb_cmd = 0.0  # m/s, slewed by PILOT_ACCEL_Z
         self._alt_target = 0.0
@@ -178,6 +180,8 @@ class FlightController:
         a = min(1.0, dt / self.p["ATC_INPUT_TC"])
         self._roll += (want_roll - self._roll) * a
         self._pitch += (want_pitch - self._pitch) * a
+        if self._crashed(s, dt):
+            return Demand(0.0, 0.0, 0.0, 0.0, False)
         tilt = max(0.5, math.cos(s.roll) * math.cos(s.pitch))
         return Demand(self._roll, self._pitch, yaw_rate, collective / tilt, True)
 
@@ -191,6 +195,16 @@ class FlightController:
         velocity = self._climb_cmd + self.p["PSC_POSZ_P"] * (self._alt_target - s.height)
         accel = self.p["PSC_VELZ_P"] * (velocity - s.climb)
         return max(0.0, self.hover * (1.0 + accel / GRAVITY)), self._climb_cmd
+
+    def _crashed(self, s: Sensors, dt: float) -> bool:
+        """ArduCopter's crash check: the attitude off its target by more than CRASH_ANGLE_DEG for CRASH_S
+        (blown over, wedged against a wall) disarms the motors."""
+        error = math.degrees(max(abs(s.roll - self._roll), abs(s.pitch - self._pitch)))
+        self._crash_timer = self._crash_timer + dt if error > self.p["CRASH_ANGLE_DEG"] else 0.0
+        if self._crash_timer >= self.p["CRASH_S"]:
+            self.armed, self._crash_timer = False, 0.0
+            return True
+        return False
 
     def _land_detector(self, climb_demand: float, s: Sensors, dt: float) -> None:
         if climb_demand > 0.0:

@@ -11,7 +11,7 @@ import pytest
 
 from pilot.detect import HsvBlobDetector
 from pilot.sim import mj, rc
-from pilot.sim.arducopter import desired_climb_rate, desired_lean
+from pilot.sim.arducopter import FlightController, Mode, Sensors, desired_climb_rate, desired_lean
 from pilot.sim.camera import CameraModel
 from pilot.sim.physics import Airframe
 from pilot.sim.room import SCENARIOS, make_scenario
@@ -193,3 +193,21 @@ def test_the_flying_pilot_never_imports_the_simulator() -> None:
             "print(bad); sys.exit(1 if bad else 0)")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
     assert run.returncode == 0, run.stdout + run.stderr
+
+
+def test_the_crash_check_disarms_an_airframe_stuck_off_its_attitude() -> None:
+    """Wedged against a wall at 60° of roll, in the air: ArduCopter's crash check disarms after 2 s."""
+    fc = FlightController(PARAMS, PARAMS.airframe.mass_kg, 4 * PARAMS.airframe.motor_max_n)
+    fc.armed, fc.landed, fc.mode = True, False, Mode.ALT_HOLD
+    pulses = (MEDIANS["roll"], MEDIANS["pitch"], MEDIANS["throttle"], MEDIANS["yaw"], float(ALT_HOLD))
+    stuck = Sensors(math.radians(60), 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+    level = Sensors(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+    for _ in range(round(1.5 / 0.002)):
+        assert fc.step(pulses, stuck, 0.002).motors_on
+    fc.step(pulses, level, 0.002)  # back on its attitude: the count starts again
+    for _ in range(round(1.9 / 0.002)):
+        fc.step(pulses, stuck, 0.002)
+    assert fc.armed
+    for _ in range(round(0.2 / 0.002)):
+        demand = fc.step(pulses, stuck, 0.002)
+    assert not fc.armed and not demand.motors_on
