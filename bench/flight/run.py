@@ -29,15 +29,15 @@ from pilot.sim.room import SCENARIOS
 
 HERE = Path(__file__).resolve().parent
 LOG = HERE.parents[1] / "build" / "bench-flight" / "flights.jsonl"
-GUSTS = 0.5  # m/s: the gust process' strength in the gust campaign
+GUSTS = 0.5  # m/s: the gust process' strength in the gust campaign (its stationary standard deviation)
 TICK_S = 0.05  # the pilot's 20 Hz: simulated time per frame
 
 
-def jobs(seeds: int, gust_seeds: int, executable: str | None) -> list[FlightJob]:
+def jobs(seeds: int, gust_seeds: int, executable: str | None, gusts: float = GUSTS) -> list[FlightJob]:
     out = [FlightJob(name, seed, "hsv", executable=executable) for seed in range(seeds) for name in SCENARIOS]
     out += [FlightJob(name, seed, "aruco", width=640, height=480, executable=executable)
             for seed in range(seeds) for name in SCENARIOS]
-    out += [FlightJob(name, 1000 + seed, "hsv", executable=executable, gusts=GUSTS)
+    out += [FlightJob(name, 1000 + seed, "hsv", executable=executable, gusts=gusts)
             for seed in range(gust_seeds) for name in SCENARIOS]
     return out
 
@@ -50,11 +50,11 @@ def _run(job: FlightJob) -> dict[str, Any]:
     return row
 
 
-def campaign(todo: list[FlightJob], processes: int) -> None:
-    LOG.parent.mkdir(parents=True, exist_ok=True)
-    LOG.write_text("")
+def campaign(todo: list[FlightJob], processes: int, log_path: Path = LOG) -> None:
+    log_path.parent.mkdir(parents=True, exist_ok=True)
+    log_path.write_text("")
     ctx = multiprocessing.get_context("spawn")  # a forked child would inherit MuJoCo's GL context
-    with ctx.Pool(processes) as pool, LOG.open("a") as log:
+    with ctx.Pool(processes) as pool, log_path.open("a") as log:
         for n, row in enumerate(pool.imap_unordered(_run, todo, chunksize=1), 1):
             log.write(json.dumps(row) + "\n")
             log.flush()
@@ -73,7 +73,8 @@ def _pct(n: int, d: int) -> str:
 def summarize(rows: list[dict[str, Any]]) -> str:
     groups: dict[str, list[dict[str, Any]]] = defaultdict(list)
     for r in rows:
-        groups[f"{r['detector']}{' + gusts' if r['gusts'] else ''}"].append(r)
+        gusts = f" + gusts {r['gusts']:g} m/s" if r["gusts"] else ""
+        groups[f"{r['detector']}{gusts}"].append(r)
     lines = ["| flights | reached and lit | non-target laser hits | wall hits (flights) | crashes | ended disarmed, "
              "laser off |", "|---|---|---|---|---|---|"]
     for name, rs in sorted(groups.items()):
@@ -134,7 +135,17 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--virtual-drone", default=os.environ.get("PILOT_VIRTUAL_DRONE"))
     p.add_argument("--summarize", action="store_true", help="only rewrite RESULTS.md from the last campaign's log")
     p.add_argument("--speed-only", action="store_true", help="only the one-core speed probe (SPEED.md)")
+    p.add_argument("--gusts-only", type=float, metavar="M/S",
+                   help="only the gust flights, at this strength (GUSTS-<strength>.md, its own log)")
     args = p.parse_args(argv)
+    if args.gusts_only is not None:
+        log = LOG.with_name(f"gusts-{args.gusts_only:g}.jsonl")
+        campaign(jobs(0, args.gust_seeds, args.virtual_drone, args.gusts_only), args.processes, log)
+        rows = [json.loads(line) for line in log.read_text().splitlines() if line.strip()]
+        text = f"# Gusts of {args.gusts_only:g} m/s\n\n{summarize(rows)}\n"
+        print(text)
+        (HERE / f"GUSTS-{args.gusts_only:g}.md").write_text(text)
+        return 0
     t0 = time.perf_counter()
     if args.speed_only or not args.summarize:
         text = "\n".join(["# The simulator's speed on one core", "",

@@ -157,7 +157,7 @@ class FlightController:
         self._arming(throttle <= 0.0, yaw_in, dt)
         if not self.armed:
             self._roll = self._pitch = self._climb_cmd = 0.0
-            self.landed = s.height < 0.05
+            self.landed = abs(s.climb) < 0.1  # resting (on the floor or on a table), not falling
             return Demand(0.0, 0.0, 0.0, 0.0, False)
         want_roll, want_pitch = desired_lean(self.p, roll_in, pitch_in)
         yaw_rate = math.radians(self.p["PILOT_Y_RATE"]) * yaw_in / ANGLE_RANGE
@@ -170,7 +170,7 @@ class FlightController:
             collective = stabilize_throttle(self.p, throttle)
             climb_demand = collective - self.hover
             self._alt_target = s.height
-        self._land_detector(climb_demand, s, dt)
+        self._land_detector(climb_demand, collective, s, dt)
         if self.landed:
             # spooled down on the ground: no lean, no turn, motors at their floor until a climb is asked for
             self._roll = self._pitch = 0.0
@@ -206,12 +206,14 @@ class FlightController:
             return True
         return False
 
-    def _land_detector(self, climb_demand: float, s: Sensors, dt: float) -> None:
+    def _land_detector(self, climb_demand: float, collective: float, s: Sensors, dt: float) -> None:
+        """Landed as ArduCopter tells it, without knowing the height of what it stands on (the floor, a table):
+        asked not to climb, thrust well under hover and yet not descending, for LAND_DETECT_S."""
         if climb_demand > 0.0:
             self.landed = False
             self._land_timer = 0.0
             return
-        if s.height < 0.05 and abs(s.climb) < 0.3:
+        if collective < 0.75 * self.hover and abs(s.climb) < 0.1:
             self._land_timer += dt
             if self._land_timer >= self.p["LAND_DETECT_S"]:
                 self.landed = True

@@ -199,6 +199,7 @@ def test_the_crash_check_disarms_an_airframe_stuck_off_its_attitude() -> None:
     """Wedged against a wall at 60° of roll, in the air: ArduCopter's crash check disarms after 2 s."""
     fc = FlightController(PARAMS, PARAMS.airframe.mass_kg, 4 * PARAMS.airframe.motor_max_n)
     fc.armed, fc.landed, fc.mode = True, False, Mode.ALT_HOLD
+    fc._alt_target = 1.0  # holding the 1 m it flies at
     pulses = (MEDIANS["roll"], MEDIANS["pitch"], MEDIANS["throttle"], MEDIANS["yaw"], float(ALT_HOLD))
     stuck = Sensors(math.radians(60), 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)
     level = Sensors(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)
