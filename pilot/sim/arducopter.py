@@ -28,6 +28,7 @@ import drone_protocol as dp
 from .rc import ANGLE_RANGE, THROTTLE_RANGE, SimParams
 
 GRAVITY = 9.81
+ARM_TICK_S = 0.1  # ArduCopter's arm_motors_check runs at 10 Hz
 
 
 class Mode(enum.IntEnum):
@@ -102,8 +103,10 @@ class FlightController:
         self.landed = True
         self.mode = Mode.STABILIZE
         self.failsafe = False
-        self._arm_timer = 0.0
-        self._disarm_timer = 0.0
+        self._arm_ticks = 0
+        self._disarm_ticks = 0
+        self._clock = 0.0
+        self._next_tick = 0.0
         self._land_timer = 0.0
         self._crash_timer = 0.0
         self._mode_pwm = -1.0
@@ -114,20 +117,26 @@ class FlightController:
 
     # -- the sticks --------------------------------------------------------------------------------------
     def _arming(self, throttle_zero: bool, yaw_in: float, dt: float) -> None:
-        hold = self.p["ARM_DELAY_S"]
+        """ArduCopter's stick (dis)arming runs at 10 Hz and counts its ticks: the sticks held at ARM_DELAY_S'
+        worth of ticks in a row (the last one up to a tick early, depending on the phase) arm or disarm."""
+        self._clock += dt
+        if self._clock < self._next_tick:
+            return
+        self._next_tick += ARM_TICK_S
+        ticks = round(self.p["ARM_DELAY_S"] / ARM_TICK_S)
         if throttle_zero and yaw_in > 4000.0 and not self.armed and self.landed and not self.failsafe:
-            self._arm_timer += dt
-            if self._arm_timer >= hold - 1e-9:
-                self.armed, self._arm_timer = True, 0.0
+            self._arm_ticks += 1
+            if self._arm_ticks >= ticks:
+                self.armed, self._arm_ticks = True, 0
                 self._alt_target = 0.0
         else:
-            self._arm_timer = 0.0
+            self._arm_ticks = 0
         if throttle_zero and yaw_in < -4000.0 and self.armed and self.landed:
-            self._disarm_timer += dt
-            if self._disarm_timer >= hold - 1e-9:
-                self.armed, self._disarm_timer = False, 0.0
+            self._disarm_ticks += 1
+            if self._disarm_ticks >= ticks:
+                self.armed, self._disarm_ticks = False, 0
         else:
-            self._disarm_timer = 0.0
+            self._disarm_ticks = 0
 
     def _modes(self, mode_pwm: float, throttle_pwm: float) -> None:
         fs_on = self.p["FS_THR_ENABLE"] != 0 and throttle_pwm < self.p["FS_THR_VALUE"]

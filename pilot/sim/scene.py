@@ -152,7 +152,7 @@ def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg
     <body name="target" mocap="true" pos="{_f(tx, ty, 0)}">
       {chr(10).join('      ' + g for g in target_geoms).strip()}
     </body>
-    <body name="drone" pos="{_f(sx, sy, 0.06)}" quat="{_yaw_quat(heading)}">
+    <body name="drone" pos="{_f(sx, sy, 0.05)}" quat="{_yaw_quat(heading)}">
       <freejoint name="drone"/>
       <inertial pos="0 0 0" mass="{frame.mass_kg:g}" diaginertia="{_f(ix, iy, iz)}"/>
       <geom name="airframe" type="box" size="{_f(frame.radius_m, frame.radius_m, 0.05)}" mass="0"
