@@ -135,6 +135,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--virtual-drone", default=os.environ.get("PILOT_VIRTUAL_DRONE"))
     p.add_argument("--summarize", action="store_true", help="only rewrite RESULTS.md from the last campaign's log")
     p.add_argument("--speed-only", action="store_true", help="only the one-core speed probe (SPEED.md)")
+    p.add_argument("--detector", choices=("hsv", "aruco"), help="only this detector's still-air flights")
     p.add_argument("--gusts-only", type=float, metavar="M/S",
                    help="only the gust flights, at this strength (GUSTS-<strength>.md, its own log)")
     args = p.parse_args(argv)
@@ -158,8 +159,11 @@ def main(argv: list[str] | None = None) -> int:
         if args.speed_only:
             return 0
     if not args.summarize:
-        campaign(jobs(args.seeds, args.gust_seeds, args.virtual_drone), args.processes)
-    rows = [json.loads(line) for line in LOG.read_text().splitlines() if line.strip()]
+        todo = [j for j in jobs(args.seeds, args.gust_seeds, args.virtual_drone)
+                if args.detector is None or (j.detector == args.detector and not j.gusts)]
+        campaign(todo, args.processes, LOG.with_name(f"{args.detector}.jsonl") if args.detector else LOG)
+    log = LOG.with_name(f"{args.detector}.jsonl") if args.detector else LOG
+    rows = [json.loads(line) for line in log.read_text().splitlines() if line.strip()]
     text = "\n".join([
         "# Closed-loop campaign in the MuJoCo simulator",
         "",
@@ -171,7 +175,7 @@ def main(argv: list[str] | None = None) -> int:
         "",
     ])
     print(text)
-    (HERE / "RESULTS.md").write_text(text)
+    (HERE / (f"RESULTS-{args.detector}.md" if args.detector else "RESULTS.md")).write_text(text)
     return 0
 
 
