@@ -53,6 +53,7 @@ from .gating import Gate
 
 __all__ = ["FLYING", "LOCKED", "Controller", "State", "Transition"]
 
+STICK_CHANNELS = frozenset(c.value for c in dp.ChannelName)  # commands that move a stick
 HOLD_MPS = 0.12  # closing speeds within this are left alone near the target (the estimate's noise)
 
 
@@ -114,7 +115,7 @@ class Controller(ControllerCore):
             sense = 1 if command.name is dp.CommandName.MOVE_FORWARD else -1
             self._pitch_steps = sense * abs(int(command.value or median) - median) / dp.SPEED_STEP_US
             self._pitch_until_ms = self._now() + dp.COMMAND_TIMEOUT_MS
-        elif channel in {c.value for c in dp.ChannelName} or command.name is dp.CommandName.HOLD_ALTITUDE:
+        elif channel in STICK_CHANNELS or command.name is dp.CommandName.HOLD_ALTITUDE:
             self._pitch_steps = 0.0
 
     def _decide_frame(self, det: Detection | None) -> bytes | None:

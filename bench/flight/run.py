@@ -158,11 +158,11 @@ def main(argv: list[str] | None = None) -> int:
         (HERE / "SPEED.md").write_text(text)
         if args.speed_only:
             return 0
+    log = LOG.with_name(f"{args.detector}.jsonl") if args.detector else LOG
     if not args.summarize:
         todo = [j for j in jobs(args.seeds, args.gust_seeds, args.virtual_drone)
                 if args.detector is None or (j.detector == args.detector and not j.gusts)]
-        campaign(todo, args.processes, LOG.with_name(f"{args.detector}.jsonl") if args.detector else LOG)
-    log = LOG.with_name(f"{args.detector}.jsonl") if args.detector else LOG
+        campaign(todo, args.processes, log)
     rows = [json.loads(line) for line in log.read_text().splitlines() if line.strip()]
     text = "\n".join([
         "# Closed-loop campaign in the MuJoCo simulator",

@@ -10,6 +10,7 @@ seed and cycled), JPEG compression.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 
 import cv2
@@ -102,8 +103,6 @@ class Sensor:
         return np.array(self.data.cam_xpos[self.cam_id]), -xmat[:, 2]
 
     def render(self, t: float) -> Image:
-        import time
-
         t0 = time.perf_counter()
         self.renderer.update_scene(self.data, camera=self.cam_id)
         rgb = self.renderer.render()
@@ -134,8 +133,7 @@ class Sensor:
 
     def _blur_px(self, t: float) -> FloatArray | None:
         """A line kernel along the image motion that the axis' angular rate makes over the exposure."""
-        origin, axis = self.axis()
-        del origin
+        _, axis = self.axis()
         last, dt = self._last_axis, t - self._last_t
         self._last_axis, self._last_t = axis, t
         if last is None or dt <= 0.0:

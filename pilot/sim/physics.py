@@ -16,13 +16,14 @@ import numpy as np
 import numpy.typing as npt
 
 from . import mj
-from .arducopter import GRAVITY, FlightController, Sensors
+from .arducopter import FlightController, Sensors
 from .rc import SimParams
 from .room import Scenario
 from .scene import HIDDEN_GROUP, MOTOR_SPIN, motor_positions
 
 FloatArray = npt.NDArray[np.float64]
 HIT_GAP_S = 0.5
+BODY_HALF_HEIGHT = 0.05  # the airframe's collision box: its centre rests this high on the floor
 
 
 @dataclass
@@ -38,6 +39,14 @@ class AirframeState:
     crashes: int = 0
     touching: bool = False
     hit_what: list[str] = field(default_factory=list)  # what each wall hit touched, and when
+
+
+def _euler(w: float, x: float, y: float, z: float) -> tuple[float, float, float]:
+    """Roll, pitch and yaw (ZYX, MuJoCo's FLU frame) of a unit quaternion."""
+    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
+    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return roll, pitch, yaw
 
 
 def _mixer(arm: float, yaw_moment: float) -> FloatArray:
@@ -64,8 +73,9 @@ class Airframe:
         self._moving = scenario.target_motion[0] != 0.0 or scenario.target_motion[1] != 0.0
         self._hides = bool(scenario.hidden)
         self.body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "drone")
-        self.target_body = model.body_mocapid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "target")]
-        self.target_home = np.array(model.body_pos[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "target")])
+        target = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "target")
+        self.target_body = model.body_mocapid[target]
+        self.target_home = np.array(model.body_pos[target])
         self.floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "floor")
         self.airframe_geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "airframe")
         self.target_geoms = [i for i in range(model.ngeom)
@@ -81,13 +91,10 @@ class Airframe:
 
     # -- sensing ------------------------------------------------------------------------------------------
     def sensors(self) -> Sensors:
-        w, x, y, z = self.data.qpos[3:7].tolist()
-        roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
-        pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
-        yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+        roll, pitch, yaw = _euler(*self.data.qpos[3:7].tolist())
         v = self.data.qvel.tolist()  # angular part: body frame (FLU) for a free joint
         # ArduCopter's senses: roll right-down (FLU +x), pitch nose-up (FLU -y), yaw clockwise (FLU -z)
-        return Sensors(roll, -pitch, -yaw, v[3], -v[4], -v[5], float(self.data.qpos[2]) - 0.05, v[2])
+        return Sensors(roll, -pitch, -yaw, v[3], -v[4], -v[5], float(self.data.qpos[2]) - BODY_HALF_HEIGHT, v[2])
 
     # -- one step -----------------------------------------------------------------------------------------
     def step(self, pulses: tuple[float, float, float, float, float], dt: float) -> None:
@@ -151,10 +158,11 @@ class Airframe:
 
     def _score_contacts(self) -> None:
         d, st = self.data, self.state
-        touching = False
+        touching = on_floor = False
         for i in range(d.ncon):
             c = d.contact[i]
             pair = (int(c.geom1), int(c.geom2))
+            on_floor = on_floor or self.floor in pair
             if self.airframe_geom not in pair:
                 continue
             other = pair[0] if pair[1] == self.airframe_geom else pair[1]
@@ -168,22 +176,18 @@ class Airframe:
                 st.hit_what.append(f"{name} at {self.t:.1f} s")
                 st.wall_hits += 1
             touching = True
-        self._on_floor = any(self.floor in (int(d.contact[i].geom1), int(d.contact[i].geom2)) for i in range(d.ncon))
+        self._on_floor = on_floor
         if touching:
             self._last_touch_t = self.t
         st.touching = touching
 
     def _update_state(self) -> None:
         st, q = self.state, self.data.qpos.tolist()
-        st.x, st.y, st.z = q[0], q[1], max(0.0, q[2] - 0.05)
+        st.x, st.y, st.z = q[0], q[1], max(0.0, q[2] - BODY_HALF_HEIGHT)
         w, x, y, z = q[3:7]
-        st.heading = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+        st.heading = _euler(w, x, y, z)[2]
         st.armed = self.fc.armed
         up = 1.0 - 2.0 * (x * x + y * y)  # the body's z axis against the world's
         if up < 0.3 and not self._tipped:
             self._tipped = True
             st.crashes += 1
-
-    @property
-    def hover_collective(self) -> float:
-        return self.frame.mass_kg * GRAVITY / (4.0 * self.frame.motor_max_n)

@@ -48,8 +48,7 @@ def _wall_plane(name: str, x: float, y: float, z: float, normal_heading: float, 
 
 
 class _Writer:
-    def __init__(self, scenario: Scenario) -> None:
-        self.sc = scenario
+    def __init__(self) -> None:
         self.assets: dict[str, bytes] = {}
         self.materials: list[str] = []
 
@@ -81,7 +80,7 @@ class _Writer:
 
 def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg: float) -> Built:
     sc, room = scenario, scenario.room
-    w = _Writer(sc)
+    w = _Writer()
     walls = w.photo_material(sc.wall_texture, (4.0, 1.5), "0.85 0.82 0.78 1")
     floor = w.photo_material(sc.floor_texture, (6.0, 5.0), "0.7 0.68 0.62 1")
     ceiling = w.colour_material("ceiling", (0.88, 0.88, 0.86))

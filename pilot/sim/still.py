@@ -9,9 +9,9 @@ import drone_protocol as dp
 import numpy as np
 
 from . import mj, rc
-from .camera import CameraModel, Image, Sensor, mount_rotation
+from .camera import CameraModel, Image, Sensor
 from .room import Scenario
-from .scene import CAMERA_POS, build
+from .scene import build
 
 
 class StillView:
@@ -53,5 +53,3 @@ class StillView:
     def close(self) -> None:
         self.sensor.close()
 
-
-__all__ = ["CAMERA_POS", "StillView", "mount_rotation"]

@@ -149,9 +149,6 @@ class SimWorld(Closing):
         mujoco.mj_ray(self.mj_model, self.mj_data, origin, axis, self._ray_groups, 1, self.airframe.body, geom)
         return int(geom[0])
 
-    def laser_on_target(self) -> bool:
-        return self.laser_hit() == self._aim_geom
-
     def target_position(self) -> tuple[float, float, float]:
         geom = self._aim_geom
         x, y, z = (float(v) for v in self.mj_data.geom_xpos[geom])
