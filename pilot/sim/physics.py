@@ -125,7 +125,7 @@ class Airframe:
         self.t += dt
         if self.data.ncon:
             self._score_contacts()
-        elif self.state.touching:
+        else:  # airborne: the next floor contact is a touchdown, judged on its speed
             self.state.touching = False
             self._on_floor = False
         self._update_state()
