@@ -275,8 +275,8 @@ class ControllerCore:
             return self._emit(dp.land())
         owed = self.drone.disarm_owed_since_ms
         if owed is not None and state is dp.DroneState.DISARMED:
-            # the board's throttle is at its minimum: after the landing routine's time the drone is down, and
-            # the flight controller (which disarms only on the ground) sees the disarm sticks too
+            # the rebooted board holds the failsafe throttle, so the flight controller lands on its own: after the
+            # landing routine's time it is down, and then sees the disarm sticks too (it disarms only on the ground)
             return self._emit(dp.disarm()) if self._now() - owed >= dp.LANDING_MS else self._status_poll()
         if self.drone.safe:
             self._go(State.DONE, f"drone confirmed {self.drone.describe()}")

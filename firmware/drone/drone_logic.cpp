@@ -73,6 +73,11 @@ void Drone::begin(uint32_t now_ms) {
   out_.tilt = dp::SERVO_TILT_DEFAULT;
   out_.laser = false;
   enter(State::Disarmed);
+  // A boot may be a reset in flight (DTR when the Pi reopens the port, a
+  // brown-out): throttle minimum in Stabilize would drop the drone. Below
+  // FS_THR_VALUE the flight controller lands instead (and merely disarms when
+  // already on the ground). The first arming sequence raises it to minimum.
+  out_.throttle = dp::FAILSAFE_THROTTLE_US;
   char line[dp::REPLY_MAX_LENGTH];
   reply(line, dp::write_ready(line));
 }

@@ -20,7 +20,8 @@ namespace dp = drone_protocol;
 // from spec/drone.yaml, so every reply reports exactly this). One state
 // machine: sequences (arming, landing, disarming, self-test) are states, so
 // nothing ever waits in delay().
-//   disarmed       throttle minimum, other sticks neutral
+//   disarmed       throttle minimum, other sticks neutral (from boot until
+//                  the first sequence: the failsafe throttle)
 //   arming         throttle minimum + yaw full right for ARMING_HOLD_MS
 //   armed          armed, throttle minimum (on the ground)
 //   hold_altitude  sticks neutral, throttle median, mode alt-hold

@@ -158,7 +158,7 @@ class Airframe:
 
     def _score_contacts(self) -> None:
         d, st = self.data, self.state
-        touching = on_floor = False
+        touching = on_floor = touched_down = False
         for i in range(d.ncon):
             c = d.contact[i]
             pair = (int(c.geom1), int(c.geom2))
@@ -167,8 +167,10 @@ class Airframe:
                 continue
             other = pair[0] if pair[1] == self.airframe_geom else pair[1]
             if other == self.floor:
-                if -float(d.qvel[2]) > self.frame.crash_speed and not self._on_floor:
+                # judged once per touchdown (a landing makes several contacts in the same step)
+                if -float(d.qvel[2]) > self.frame.crash_speed and not self._on_floor and not touched_down:
                     st.crashes += 1
+                touched_down = True
                 continue
             # one hit per touch: a bouncing contact (on and off within HIT_GAP_S) is the same touch
             if not st.touching and not touching and self.t - self._last_touch_t > HIT_GAP_S:

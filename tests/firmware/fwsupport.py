@@ -57,6 +57,11 @@ def on_ground() -> dict[str, int]:
     return {**neutral(), "throttle": dp.CHANNELS[dp.ChannelName.THROTTLE].minimum}
 
 
+def at_boot() -> dict[str, int]:
+    """Sticks neutral with the failsafe throttle: from boot until the first sequence (a reset may be in flight)."""
+    return {**neutral(), "throttle": dp.FAILSAFE_THROTTLE_US}
+
+
 # --- reply lines, from the spec's model ----------------------------------------------------------------------------
 
 

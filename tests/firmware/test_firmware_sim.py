@@ -37,7 +37,7 @@ def reply(line: bytes) -> str:
 class Model:
     """What the firmware should output (the spec's rules, as the README states them)."""
 
-    sticks: dict[str, int] = field(default_factory=fw.on_ground)
+    sticks: dict[str, int] = field(default_factory=fw.at_boot)
     mode: int = dp.MODE_STABILIZE_US
     pan: int = dp.SERVOS[dp.ServoName.PAN].default
     tilt: int = dp.SERVOS[dp.ServoName.TILT].default
@@ -234,10 +234,12 @@ def test_too_long_frame_on_the_stream_is_a_frame_and_a_stray_byte() -> None:
 
 
 def test_failsafe_fires_at_its_time_on_the_real_binary() -> None:
-    last_frame_ms = 100.0
-    events = [(last_frame_ms, dp.laser_toggle())]
+    plan, model = Plan(), Model()
+    arm(plan, model)  # armed on the ground: the throttle at its minimum until the failsafe
+    plan.send(dp.laser_toggle())
+    last_frame_ms = plan.t
     end = last_frame_ms + dp.FAILSAFE_TIMEOUT_MS + 100
-    result = fw.simulate(events, end)
+    result = fw.simulate(plan.events, end)
     (t_fs,) = [t for t, text in result.tx if fw.R.body(text.rstrip("\n")) == fw.R.failsafe()]
     frame_done_ms = last_frame_ms + len(dp.laser_toggle()) * 10_000 / dp.BAUD  # 10 bits per byte
     fired_ms = t_fs / 16000
@@ -258,7 +260,9 @@ def test_garbage_between_frames_never_changes_an_output_to_an_uncommanded_value(
     rng = random.Random(1234)
     plan, model = Plan(), Model()
     arm(plan, model)
-    commanded: dict[str, set[int]] = {name: {fw.neutral()[name], fw.on_ground()[name]} for name in fw.STICKS}
+    commanded: dict[str, set[int]] = {
+        name: {fw.neutral()[name], fw.on_ground()[name], fw.at_boot()[name]} for name in fw.STICKS
+    }
     commanded["yaw"].add(dp.CHANNELS[dp.ChannelName.YAW].maximum)  # the arming hold
     frames_sent: list[bytes] = []
     sticks = [s for s in dp.COMMANDS.values() if s.category in (dp.Category.MOVE, dp.Category.TURN)]
@@ -311,7 +315,7 @@ def test_mega_2560_build_drives_the_same_arduino_pins() -> None:
     )
     assert result.replies()[:3] == [fw.R.ready(), fw.R.accepted(dp.laser_toggle()), fw.R.accepted(dp.servo_right(45))]
     expected = {
-        **fw.on_ground(),
+        **fw.at_boot(),
         "mode": dp.MODE_STABILIZE_US,
         "pan": fw.servo_us(dp.SERVOS[dp.ServoName.PAN].default + 45),
         "tilt": fw.servo_us(dp.SERVOS[dp.ServoName.TILT].default),
@@ -333,10 +337,10 @@ def test_ppm_build_sends_the_rc_channels_as_one_ppm_sum_train() -> None:
     i = frame_starts[0]
     channels = [rises[i + k + 1] - rises[i + k] for k in range(5)]
     expected = [
-        fw.on_ground()["roll"],
-        fw.on_ground()["pitch"],
-        fw.on_ground()["throttle"],
-        fw.on_ground()["yaw"],
+        fw.at_boot()["roll"],
+        fw.at_boot()["pitch"],
+        fw.at_boot()["throttle"],
+        fw.at_boot()["yaw"],
         dp.MODE_STABILIZE_US,
     ]
     assert all(abs(c - e) <= TOLERANCE_US for c, e in zip(channels, expected, strict=True)), channels
