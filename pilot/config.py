@@ -68,6 +68,7 @@ class ControllerConfig:
     dead_band_y: float = 0.16  # normalised vertical image error left alone
     approach_size: float = 0.19  # apparent size (fraction of frame width) at which approach stops
     retreat_size: float = 0.14  # hysteresis: below this, approach again
+    back_off_size: float = 0.3  # above this (closer than the pole's reach), AIM backs off before it fires
     aim_tolerance: float = 0.05  # normalised error within which the aim counts as centred
     aim_frames: int = 3  # centred frames before the laser goes on
     fire_ms: int = 1500  # laser on time
@@ -188,6 +189,7 @@ RANGES: dict[str, tuple[float, float]] = {
     "controller.dead_band_y": (0.0, 1.0),
     "controller.approach_size": (0.001, 1.0),
     "controller.retreat_size": (0.0, 1.0),
+    "controller.back_off_size": (0.001, 1.0),
     "controller.aim_tolerance": (0.001, 1.0),
     "controller.brake_mps2": (0.05, 5.0),
     "controller.approach_speed_mps": (0.05, 3.0),
@@ -235,6 +237,11 @@ def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
         raise ConfigError(
             f"{where}: option 'controller.retreat_size' ({c.retreat_size}) must be below "
             f"'controller.approach_size' ({c.approach_size}) for the hysteresis to work"
+        )
+    if c.back_off_size <= c.approach_size:
+        raise ConfigError(
+            f"{where}: option 'controller.back_off_size' ({c.back_off_size}) must be above "
+            f"'controller.approach_size' ({c.approach_size}): AIM would back off from where it stops"
         )
     return config
 

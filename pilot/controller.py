@@ -22,8 +22,9 @@ States (``State``)::
   ``lost_frames`` misses in a row it searches again.
 * TRACK corrects one axis per frame: yaw while the horizontal error is outside its dead band, then
   height while the vertical error is, else forward until the apparent size reaches ``approach_size``.
-  AIM begins there and returns to TRACK only below ``retreat_size`` (hysteresis). Up to ``coast_frames``
-  missed frames during a forward approach keep it going (a far target flickers in and out of detection).
+  AIM begins there and returns to TRACK only below ``retreat_size`` (hysteresis); above ``back_off_size`` it
+  backs off before it fires. Up to ``coast_frames`` missed frames during a forward approach keep it going (a
+  far target flickers in and out of detection).
 * AIM holds position and centres the target with the pan/tilt servos; after ``aim_frames`` centred
   frames FIRE switches the laser on. The laser stays on only while the target is found and centred;
   after ``fire_ms`` lit (as the drone confirmed it) it is switched off and the drone lands. While
@@ -259,6 +260,13 @@ class Controller(ControllerCore):
         if det.relative_size < self.cfg.retreat_size:
             self._go(State.TRACK, f"target receded (size {det.relative_size:.3f})")
             return self._on_track(det)
+        if det.relative_size > self.cfg.back_off_size:
+            # coasted in too close (a lock lost on the way): a landing from here comes down on the target's
+            # stand, so back off first (once backing away, the range hold below brakes it)
+            self._centred = 0
+            closing = self.closing.closing
+            if closing is None or closing > -HOLD_MPS:
+                return self._brake(max(0.0, closing or 0.0))
         hold = self._hold_range()
         if hold is not None:  # still coasting in (or drifting away): that first
             self._centred = 0

@@ -276,6 +276,13 @@ def test_track_to_aim_with_size_hysteresis() -> None:
     assert st(c) is State.TRACK and name(out) == "move_forward"
 
 
+def test_aim_backs_off_a_target_it_coasted_up_to_before_it_fires() -> None:
+    c, rig = to_state(State.AIM)
+    close = seen(size=CFG.back_off_size * 1.2)
+    outs = [name(rig.tick(close)) for _ in range(CFG.aim_frames + 2)]
+    assert st(c) is State.AIM and "move_backward" in outs and "laser_on" not in outs
+
+
 @pytest.mark.parametrize(
     "ex,ey,expected",
     [(0.3, 0.0, "servo_right"), (-0.3, 0.0, "servo_left"), (0.0, -0.3, "servo_up"), (0.0, 0.3, "servo_down")],

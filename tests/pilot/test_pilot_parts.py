@@ -42,6 +42,7 @@ def test_config_round_trip(tmp_path: Path) -> None:
         ("hsv:\n  ranges: [[[0, 0, 0], [200, 255, 255]]]\n", "option 'hsv.ranges[0]'"),
         ("hsv:\n  ranges: [[[0, 0], [10, 255, 255]]]\n", "option 'hsv.ranges[0][0]' must have 3 items"),
         ("controller:\n  retreat_size: 0.5\n", "option 'controller.retreat_size'"),
+        ("controller:\n  back_off_size: 0.1\n", "option 'controller.back_off_size'"),
         ("link: 5\n", "option 'link' must be a mapping"),
         ("- a\n- b\n", "the top level must be a mapping"),
     ],
