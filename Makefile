@@ -59,7 +59,7 @@ typecheck: $(VENV_STAMP)
 	$(VENV)/bin/mypy --strict generator generated/python/drone_protocol pilot tests bench firmware/ide
 
 pytest: deps
-	$(PY) -m pytest -q tests
+	$(PY) -m pytest -q -n 2 --dist loadgroup tests
 
 test: deps check-generated lint typecheck pytest fuzz-smoke
 
