@@ -16,11 +16,18 @@ import pytest
 TESTS = Path(__file__).resolve().parent
 
 
+@pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which reads the groups
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
         folder = item.path.resolve().relative_to(TESTS).parts[0]
         item.add_marker(pytest.mark.xdist_group("pilot" if folder == "pilot" else "shared-builds"))
 
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    # xdist marks a grouped test by a suffix of its node id; without it the groups would silently mix
+    if session.config.getoption("dist", "no") == "loadgroup" and any("@" not in i.nodeid for i in session.items):
+        raise pytest.UsageError("pytest-xdist did not group the tests (pytest 9 ignores its node ids): pytest<9")
 
 _popen_init = subprocess.Popen.__init__
 
@@ -40,3 +47,4 @@ def _popen_init_again_if_text_file_busy(self: subprocess.Popen[Any], *args: Any,
 
 
 subprocess.Popen.__init__ = _popen_init_again_if_text_file_busy  # type: ignore[method-assign]
+
