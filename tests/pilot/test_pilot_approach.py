@@ -7,7 +7,7 @@ import dataclasses
 
 import drone_protocol as dp
 import pytest
-from test_pilot_controller import CFG, MISS, name, seen, st, to_state
+from controller_rig import CFG, MISS, name, seen, st, to_state
 
 from pilot.approach import ClosingSpeed, allowed_speed
 from pilot.controller import State
