@@ -120,6 +120,19 @@ SPEC = load_spec(ROOT / "spec" / "drone.yaml")
 R = Replies(SPEC)
 
 
+def sticks(change: dict[str, Any]) -> dict[str, int]:
+    """The stick channels of a recorded output change."""
+    return {name: change[name] for name in STICKS}
+
+
+def accepted(frame: bytes) -> str:
+    return R.accepted(frame)
+
+
+def rejected(kind: dp.ErrorKind) -> str:
+    return R.rejected(kind.name.lower())
+
+
 # --- firmware built from a copy of the spec ------------------------------------------------------------------------
 
 
