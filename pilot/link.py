@@ -98,6 +98,9 @@ class Link(Closing):
         # the virtual board's reboot there (opening the port resets it, as DTR resets an Uno)
         self._on_open = on_open
         self._buffer = bytearray()
+        # bytes written to and read from the port since it was (re)opened: the simulator's step barrier
+        self.bytes_written = 0
+        self.bytes_read = 0
         self._closed = False
         self._opened = False
         self.sent: deque[bytes] = deque(maxlen=history)  # the latest frames written, in order
@@ -125,6 +128,7 @@ class Link(Closing):
             return
         try:
             self._port = _open_keeping_input(self._url, self.baud)
+            self.bytes_written = self.bytes_read = 0
         except (serial.SerialException, OSError, ValueError) as exc:
             raise LinkError(f"link {self._url!r}: cannot open: {exc}") from exc
 
@@ -169,6 +173,7 @@ class Link(Closing):
         chunk = self._port.read(max(waiting, 256)) if waiting else b""
         if not chunk:
             return []
+        self.bytes_read += len(chunk)
         self._buffer.extend(chunk)
         lines: list[bytes] = []
         while True:
@@ -192,6 +197,7 @@ class Link(Closing):
         try:
             self._port.write(frame)
             self._port.flush()
+            self.bytes_written += len(frame)
         except (serial.SerialException, OSError) as exc:
             self._note("link", f"write failed: {exc}")
             return self._recover() and self.send(frame)
@@ -254,6 +260,13 @@ class Link(Closing):
         raise PortLost(f"serial port {self.name!r} lost and not back within {self.reconnect_s:.1f} s")
 
     # -- closing ----------------------------------------------------------------------------------
+    def unread(self) -> int | None:
+        """Bytes waiting on the port, not yet read; None when the port cannot say (closed or failed)."""
+        try:
+            return None if self._port is None else int(self._port.in_waiting)
+        except (serial.SerialException, OSError):
+            return None
+
     def _close_port(self) -> None:
         port, self._port = self._port, None
         if port is not None:

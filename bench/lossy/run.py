@@ -140,10 +140,10 @@ def fly(job: tuple[str, int, float, str, str]) -> FlightFigures:
     meter = Meter(proxy, tick_ms, figures)
     direct_step = vd.step
 
-    def lossy_step(ms: int) -> list[Change]:
+    def lossy_step(ms: int, sent: int | None = None) -> list[Change]:
         t0 = vd.t_ms
         proxy.up(t0)
-        changes = direct_step(ms)
+        changes = direct_step(ms, sent)
         proxy.down(vd.t_ms)
         meter.on_step(t0, vd.t_ms, changes)
         return changes

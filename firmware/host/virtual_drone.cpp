@@ -7,9 +7,12 @@
 // pty mode (default): prints {"pty": "/dev/pts/N"} first; the Pi side opens
 //   that path. Replies go back over the pty. Opening the port reboots the
 //   virtual board (as DTR does a real Uno): it prints its ready line again.
-// --clock stepped: stdin carries "step <ms>" lines; each one reads the bytes
-//   waiting on the pty, runs the loop 1 ms at a time, prints the change lines
-//   and then {"tick": t_ms}. Nothing depends on the wall clock.
+// --clock stepped: stdin carries "step <ms> [<sent>]" lines; each one reads
+//   the bytes waiting on the pty (with <sent>, the bytes the client has written
+//   since it opened the port: it waits until they all arrived), runs the loop
+//   1 ms at a time, prints the change lines and then {"tick": t_ms, "wrote": n},
+//   n the bytes written to the pty since it was opened. Nothing depends on the
+//   wall clock.
 // --stdin: serial input from stdin instead of a pty, replies printed as
 //   {"t_ms":..,"tx":"..."}. With --clock stepped, stdin is a script of lines
 //   "rx <hex bytes>", "step <ms>" and "stats" (used by the tests).
@@ -49,6 +52,10 @@ std::deque<uint8_t> g_pending;  // bytes "on the wire", not yet in the UART
 uint32_t g_byte_credit = 0;     // receive line, in 1/10000 byte units
 uint32_t g_tx_credit = 0;       // transmit line, same units
 uint32_t g_t = 0;
+// Bytes read from and written to the pty since the last client opened it: the
+// barrier of a "step <ms> <sent>" line, and the "tx" of its tick line.
+uint64_t g_rx_total = 0;
+uint64_t g_tx_total = 0;
 bool g_first = true;
 drone::Outputs g_last;
 drone::State g_last_state;
@@ -110,8 +117,8 @@ void send_replies() {
     }
   } else if (g_master >= 0 && (g_inotify < 0 || g_clients > 0)) {
     // Non-blocking: with nobody reading, replies are lost, as on a real UART.
-    ssize_t r = write(g_master, tx.data(), tx.size());
-    (void)r;
+    const ssize_t r = write(g_master, tx.data(), tx.size());
+    if (r > 0) g_tx_total += static_cast<uint64_t>(r);
   }
 }
 
@@ -156,6 +163,7 @@ void reset_if_opened() {
   // serial port that was closed.
   if (g_slave >= 0) tcflush(g_slave, TCIFLUSH);
   g_pending.clear();
+  g_rx_total = g_tx_total = 0;
   fake::reset_serial();
   drone_app::setup();
   send_replies();
@@ -170,6 +178,7 @@ void read_master() {
     const ssize_t n = read(g_master, buf, sizeof buf);
     if (n <= 0) break;  // EAGAIN, or EIO while no client has the port open
     g_pending.insert(g_pending.end(), buf, buf + n);
+    g_rx_total += static_cast<uint64_t>(n);
   }
 }
 
@@ -184,6 +193,23 @@ void settle_master() {
   if (poll(&p, 1, 0) > 0) return;
   const timespec pause = {0, 200 * 1000};  // 0.2 ms of wall time per quiet step
   nanosleep(&pause, nullptr);
+}
+
+// A step that names how many bytes the client has written since it opened the
+// port waits (up to 2 s of wall time) until they all came through the kernel's
+// pty buffer: on a loaded machine its work queue can hold them longer than
+// any fixed pause, and a frame would land a step late.
+void await_master(uint64_t sent) {
+  for (int waited_ms = 0; waited_ms < 2000; ++waited_ms) {
+    read_master();
+    if (g_rx_total >= sent) return;
+    pollfd p;
+    p.fd = g_master;
+    p.events = POLLIN;
+    poll(&p, 1, 1);
+  }
+  fprintf(stderr, "virtual_drone: %llu of %llu bytes arrived\n", static_cast<unsigned long long>(g_rx_total),
+          static_cast<unsigned long long>(sent));
 }
 
 int open_pty() {
@@ -253,12 +279,19 @@ int run_stepped() {
   char line[4096];
   while (fgets(line, sizeof line, stdin)) {
     if (strncmp(line, "step", 4) == 0) {
-      const long ms = strtol(line + 4, nullptr, 10);
+      char* rest = nullptr;
+      const long ms = strtol(line + 4, &rest, 10);
+      char* after = nullptr;
+      const long long sent = strtoll(rest, &after, 10);
       reset_if_opened();
-      settle_master();
-      read_master();
+      if (after != rest && g_master >= 0) {
+        await_master(static_cast<unsigned long long>(sent));
+      } else {
+        settle_master();
+        read_master();
+      }
       for (long i = 0; i < ms; ++i) run_one_ms();
-      printf("{\"tick\":%u}\n", g_t);
+      printf("{\"tick\":%u,\"wrote\":%llu}\n", g_t, static_cast<unsigned long long>(g_tx_total));
       fflush(stdout);
     } else if (g_opt.use_stdin && strncmp(line, "rx", 2) == 0) {
       if (!parse_hex(line + 2, g_pending)) {

@@ -148,6 +148,7 @@ def fly(
                 ready_clock=time.monotonic,
                 ready_sleep=time.sleep,
             )
+            world.link = link  # every step a barrier on the pty, both ways: deterministic under any load
             with link:
                 controller = Controller(cfg.controller, clock=world.now)
                 watchers: list[Observer] = list(observers)

@@ -4,8 +4,11 @@
 opens PATH with pyserial like any serial port. Each ``step <ms>`` line on its stdin makes the
 firmware read the bytes waiting on the pty and run that many milliseconds; it prints one JSON line
 per change of its outputs (``t_ms``, the RC pulses, servo angles, laser, armed, state) and then
-``{"tick": t_ms}``. Nothing depends on the wall clock, so a flight is deterministic and runs as fast
-as the two processes can exchange lines.
+``{"tick": t_ms, "wrote": n}``. Nothing depends on the wall clock, so a flight is deterministic and runs as
+fast as the two processes can exchange lines. The pty is the one place the kernel could make it depend on
+the machine's load (its buffer is moved by a work queue), so each step is a barrier both ways: it names the
+bytes the pilot has written since it opened the port and the firmware waits for them all (``step <ms>
+<sent>``), and the world waits until the pilot's port holds all ``n`` bytes the firmware wrote back.
 """
 
 from __future__ import annotations
@@ -92,6 +95,7 @@ class VirtualDrone(Closing):
             raise SimulatorError(f"virtual drone: expected its pty path first, got {first!r}")
         self.pty = str(first["pty"])
         self.t_ms = 0
+        self.tx_total = 0  # bytes the firmware wrote to the pty since it was last opened
         self.outputs: Outputs | None = None
         self.state = ""
         self._closed = False
@@ -109,10 +113,11 @@ class VirtualDrone(Closing):
             raise SimulatorError(f"virtual drone: not a JSON object: {line!r}")
         return data
 
-    def step(self, ms: int) -> list[Change]:
-        """Advance the firmware's clock by ``ms``; the output changes, in time order."""
+    def step(self, ms: int, sent: int | None = None) -> list[Change]:
+        """Advance the firmware's clock by ``ms``; the output changes, in time order. ``sent``: the bytes the
+        client has written to the port since it opened it; the firmware waits until they all arrived."""
         try:
-            self._stdin.write(f"step {ms}\n")
+            self._stdin.write(f"step {ms}\n" if sent is None else f"step {ms} {sent}\n")
             self._stdin.flush()
         except (BrokenPipeError, OSError) as exc:
             raise SimulatorError(f"virtual drone: cannot step ({exc})") from exc
@@ -121,6 +126,7 @@ class VirtualDrone(Closing):
             data = self._line()
             if "tick" in data:
                 self.t_ms = int(data["tick"])
+                self.tx_total = int(data.get("wrote", 0))
                 return changes
             out = _outputs(data)
             self.outputs = out

@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
@@ -44,6 +45,15 @@ class FlightScore:
     physics_ms: float = 0.0  # wall time in physics and control
     render_ms: float = 0.0  # wall time in MuJoCo's renderer
     frames: int = 0
+
+
+class PortCounts(Protocol):
+    """What the step barrier needs of the pilot's link (pilot.link.Link)."""
+
+    bytes_written: int
+    bytes_read: int
+
+    def unread(self) -> int | None: ...
 
 
 class SimWorld(Closing):
@@ -85,6 +95,7 @@ class SimWorld(Closing):
         wanted = "target_marker" if aim_point == "marker" and scenario.marker is not None else "target_ball"
         self._aim_geom = int(mujoco.mj_name2id(self.mj_model, mujoco.mjtObj.mjOBJ_GEOM, wanted))
         self._last_hit = -1
+        self.link: PortCounts | None = None  # the pilot's port on the pty, when attached: the step barrier
         changes = vd.step(BOOT_MS)
         if vd.outputs is None:
             raise SimulatorError("virtual drone reported no outputs at boot")
@@ -109,7 +120,10 @@ class SimWorld(Closing):
     def advance(self, ms: int) -> None:
         """Run the firmware ``ms`` milliseconds, then the physics over the same time in 2 ms steps, each with the
         outputs the firmware had at the step's start."""
-        changes = self.vd.step(ms)
+        link = self.link
+        changes = self.vd.step(ms, None if link is None else link.bytes_written)
+        if link is not None:
+            self._await_replies(link)
         self.changes_seen += len(changes)
         pending = list(changes)
         end = self.vd.t_ms
@@ -129,6 +143,16 @@ class SimWorld(Closing):
         self.fw_state = self.vd.state
         self.score.physics_ms += (time.perf_counter() - t0) * 1000.0
         self._record_path()
+
+    def _await_replies(self, link: PortCounts) -> None:
+        """Wait (up to 2 s of wall time) until the pilot's port holds every byte the firmware wrote back, so
+        that a reply is read in the tick it was sent whatever the machine's load."""
+        deadline = time.monotonic() + 2.0
+        while time.monotonic() < deadline:
+            unread = link.unread()
+            if unread is None or link.bytes_read + unread >= self.vd.tx_total:
+                return
+            time.sleep(0.0002)
 
     # -- the camera -----------------------------------------------------------------------------
     def render(self) -> Image:

@@ -202,8 +202,8 @@ def test_virtual_drone_over_a_pty_with_the_stepped_clock() -> None:
     assert proc.stdin is not None and proc.stdout is not None
     stdin, stdout = proc.stdin, proc.stdout
 
-    def step(ms: int) -> list[dict[str, Any]]:
-        stdin.write(f"step {ms}\n")
+    def step(ms: int, sent: int | None = None) -> list[dict[str, Any]]:
+        stdin.write(f"step {ms}\n" if sent is None else f"step {ms} {sent}\n")
         stdin.flush()
         lines = []
         while "tick" not in (line := json.loads(stdout.readline())):
@@ -222,17 +222,18 @@ def test_virtual_drone_over_a_pty_with_the_stepped_clock() -> None:
         pty = json.loads(stdout.readline())["pty"]
         boot = json.loads(stdout.readline())
         assert boot["state"] == "disarmed" and boot["t_ms"] == 0
-        assert step(5) == [{"tick": 5}]
+        assert step(5) == [{"tick": 5, "wrote": 0}]
         fd = os.open(pty, os.O_RDWR | os.O_NOCTTY)
         try:
             assert not select.select([fd], [], [], 0.05)[0]  # the boot banner went nowhere: the port was closed
+            # the step waits for the bytes the client says it wrote, and counts the bytes it wrote back
             os.write(fd, dp.laser_toggle())
-            lines = step(10)
-            assert lines[-1] == {"tick": 15}
-            (change,) = lines[:-1]
-            assert change["laser"] is True and change["t_ms"] == 6
+            lines = step(10, sent=len(dp.laser_toggle()))
             toggled = fw.R.line(fw.R.accepted(dp.laser_toggle()), "disarmed", True)
             ready = fw.R.ready().encode() + b"\n"
+            assert lines[-1] == {"tick": 15, "wrote": len(ready) + len(toggled) + 1}
+            (change,) = lines[:-1]
+            assert change["laser"] is True and change["t_ms"] == 6
             assert read_until(fd, toggled.encode() + b"\n") == ready + toggled.encode() + b"\n"
         finally:
             os.close(fd)

@@ -54,7 +54,9 @@ def fly_and_fault(stage: str, exe: Path) -> Flight:
         ready_clock=time.monotonic,
         ready_sleep=time.sleep,
         on_open=lambda: world.advance(BOOT_MS),
-    ).open()
+    )
+    world.link = link
+    link.open()
     controller = Controller(cfg.controller, clock=world.now)
     detector = HsvBlobDetector(cfg.hsv)
     camera = world.camera()
