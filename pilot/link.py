@@ -187,6 +187,13 @@ class Link(Closing):
             self._buffer.clear()
         return lines
 
+    def unread(self) -> int | None:
+        """Bytes waiting on the port, not yet read; None when the port cannot say (closed or failed)."""
+        try:
+            return None if self._port is None else int(self._port.in_waiting)
+        except (serial.SerialException, OSError):
+            return None
+
     def send(self, frame: bytes) -> bool:
         """Write one frame. Returns False when the port failed and could not be reopened in time."""
         if self._closed:
@@ -260,13 +267,6 @@ class Link(Closing):
         raise PortLost(f"serial port {self.name!r} lost and not back within {self.reconnect_s:.1f} s")
 
     # -- closing ----------------------------------------------------------------------------------
-    def unread(self) -> int | None:
-        """Bytes waiting on the port, not yet read; None when the port cannot say (closed or failed)."""
-        try:
-            return None if self._port is None else int(self._port.in_waiting)
-        except (serial.SerialException, OSError):
-            return None
-
     def _close_port(self) -> None:
         port, self._port = self._port, None
         if port is not None:

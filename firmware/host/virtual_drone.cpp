@@ -53,7 +53,7 @@ uint32_t g_byte_credit = 0;     // receive line, in 1/10000 byte units
 uint32_t g_tx_credit = 0;       // transmit line, same units
 uint32_t g_t = 0;
 // Bytes read from and written to the pty since the last client opened it: the
-// barrier of a "step <ms> <sent>" line, and the "tx" of its tick line.
+// barrier of a "step <ms> <sent>" line, and the "wrote" of its tick line.
 uint64_t g_rx_total = 0;
 uint64_t g_tx_total = 0;
 bool g_first = true;
