@@ -73,3 +73,24 @@ class Momentum:
     def advance(self, pitch_steps: float, dt: float) -> None:
         """``pitch_steps``: the pitch stick held during ``dt``, in speed steps (forward positive)."""
         self.speed += self.accel_per_step * pitch_steps * dt - self.speed * dt / self.decay_s
+
+
+GRAVITY = 9.81
+
+
+class Lean:
+    """The airframe's pitch, estimated from the pitch commands (forward, nose down, positive): in AltHold the
+    stick sets the lean angle, reached with a lag (``ATC_INPUT_TC`` and the attitude loop). The camera leans
+    with the airframe, so a brake that pitches the nose up moves the target down the frame by the change."""
+
+    def __init__(self, accel_per_step: float, lag_s: float = 0.2) -> None:
+        self.deg_per_step = math.degrees(math.atan(accel_per_step / GRAVITY))  # the lean that accelerates so
+        self.lag_s = lag_s
+        self.deg = 0.0
+
+    def reset(self) -> None:
+        self.deg = 0.0
+
+    def advance(self, pitch_steps: float, dt: float) -> None:
+        if dt > 0.0:
+            self.deg += (self.deg_per_step * pitch_steps - self.deg) * (1.0 - math.exp(-dt / self.lag_s))

@@ -74,7 +74,11 @@ class ControllerConfig:
     fire_ms: int = 1500  # laser on time
     takeoff_ms: int = 2500  # climb time after arming
     settle_ms: int = 500  # hold after take-off
-    search_max_ms: int = 20000  # bounded sweep: give up and land after this
+    search_max_ms: int = 25000  # bounded sweep: give up and land after this
+    # the sweep turns for a leg (about one turn at its yaw rate), then moves to another height and turns again:
+    # something in front of the target may hide it from one height (down one step first, then up past the start)
+    search_leg_ms: int = 7500
+    search_step_ms: int = 800  # the climb or descent between legs (full stick)
     # how long LAND waits for the drone to confirm it landed and disarmed (the firmware's landing routine and
     # disarm sequence, plus room for lost frames); then the pilot stops sending and the failsafe takes over
     land_ms: int = dp.LANDING_MS + dp.ARMING_HOLD_MS + 2000
@@ -183,6 +187,8 @@ RANGES: dict[str, tuple[float, float]] = {
     "controller.takeoff_ms": (1, 60_000),
     "controller.settle_ms": (0, 60_000),
     "controller.search_max_ms": (1, 600_000),
+    "controller.search_leg_ms": (1000, 600_000),
+    "controller.search_step_ms": (0, 5_000),
     "controller.land_ms": (_LAND_MIN_MS, 600_000),  # the firmware's landing and disarm must fit
     "controller.arm_margin_ms": (0, 10_000),
     "controller.dead_band_x": (0.0, 1.0),

@@ -17,15 +17,21 @@ States (``State``)::
   state, then waits ``arm_margin_ms``; it gives up if no arming is confirmed in time.
 * TAKEOFF climbs (``move_up``) for ``takeoff_ms``; HOLD sends ``hold_altitude()`` for ``settle_ms``.
 * SEARCH turns (a bounded sweep: ``search_max_ms`` in all, unconfirmed sightings included, then LAND)
-  towards the side the target was last seen.
+  towards the side the target was last seen, in legs of ``search_leg_ms`` (about a turn) flown at the start
+  height, one ``search_step_ms`` climb below it, one above it...: something in front may hide the target
+  from one height.
 * ACQUIRE stops turning and needs ``acquire_frames`` consecutive sightings to go on to TRACK; after
   ``lost_frames`` misses in a row it searches again.
 * TRACK corrects one axis per frame: yaw while the horizontal error is outside its dead band, then
   height while the vertical error is, else forward until the apparent size reaches ``approach_size``.
+  The camera leans with the airframe (``Lean``, estimated from the pitch commands): the height is corrected
+  for the error a level camera would see, and a brake is never so hard that its lean drops the target out of
+  the frame.
   AIM begins there and returns to TRACK only below ``retreat_size`` (hysteresis); above ``back_off_size`` it
   backs off before it fires. Up to ``coast_frames`` missed frames during a forward approach keep it going (a
   far target flickers in and out of detection).
-* AIM holds position and centres the target with the pan/tilt servos; after ``aim_frames`` centred
+* AIM holds position and centres the target with the pan/tilt servos (only from measured sightings: a
+  tracker's prediction knows nothing of the step just sent); after ``aim_frames`` centred
   frames FIRE switches the laser on. The laser stays on only while the target is found and centred;
   after ``fire_ms`` lit (as the drone confirmed it) it is switched off and the drone lands. While
   firing, small errors (within twice the aim tolerance) are still corrected
@@ -46,7 +52,7 @@ from collections.abc import Callable
 
 import drone_protocol as dp
 
-from .approach import ClosingSpeed, Momentum, allowed_speed
+from .approach import ClosingSpeed, Lean, Momentum, allowed_speed
 from .config import ControllerConfig
 from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, speed_for
 from .detection import Detection
@@ -56,6 +62,8 @@ __all__ = ["FLYING", "LOCKED", "Controller", "State", "Transition"]
 
 STICK_CHANNELS = frozenset(c.value for c in dp.ChannelName)  # commands that move a stick
 HOLD_MPS = 0.12  # closing speeds within this are left alone near the target (the estimate's noise)
+VIEW_EDGE = 0.9  # a brake's lean keeps the target's lower edge above this share of the frame's lower half
+MIN_BRAKE = 0.4  # speed steps: the gentlest brake, whatever the view allows
 
 
 class Controller(ControllerCore):
@@ -64,32 +72,53 @@ class Controller(ControllerCore):
         self.gate = Gate(self.cfg)  # vision gate (issue 12): every sighting and every laser-on goes through it
         self.closing = ClosingSpeed()
         self.momentum = Momentum(self.cfg.pitch_accel_mps2)
+        self.lean = Lean(self.cfg.pitch_accel_mps2)
         self._pitch_steps = 0.0  # the pitch stick the last command holds, in speed steps (forward positive)
         self._pitch_until_ms = 0
         self._last_ms = self._now()
         self._brake_until_ms = 0  # target lost while closing in: brake this long before searching
         self._brake_speed = 0.0
 
-    def _hold_range(self) -> bytes | None:
+    def _hold_range(self, det: Detection) -> bytes | None:
         """Near the target nothing holds position but the pilot: brake a closing speed, nudge forward against a
         receding one; None while the range holds (within ``HOLD_MPS``)."""
         closing = self.closing.closing
         if closing is None or abs(closing) <= HOLD_MPS:
             return None
         if closing > 0.0:
-            return self._brake(closing)
+            return self._brake(closing, det)
         return self._emit(dp.move_forward(speed_for(dp.CommandName.MOVE_FORWARD, min(1.2, 0.6 - closing))))
 
-    def _brake(self, speed: float) -> bytes:
-        """Pitch back against a closing speed: harder the faster it closes (up to 1.4 speed steps: a steeper
-        lean tilts the body-fixed camera off the target)."""
+    def _brake(self, speed: float, det: Detection | None = None) -> bytes:
+        """Pitch back against a closing speed: harder the faster it closes, up to 1.4 speed steps, and with the
+        target in view no harder than keeps it in the frame (the nose comes up with the brake, see ``_brake_room``)."""
         frac = min(1.4, 0.8 + speed)
+        if det is not None and det.found:
+            frac = max(MIN_BRAKE, min(frac, self._brake_room(det)))
         return self._emit(dp.move_backward(speed_for(dp.CommandName.MOVE_BACKWARD, frac)))
+
+    def _tan_v(self, det: Detection) -> float:
+        return self._tan_h * (det.height / det.width) if det.width else self._tan_h
+
+    def _brake_room(self, det: Detection) -> float:
+        """The backward lean, in speed steps, that keeps the target's lower edge within ``VIEW_EDGE`` of the
+        frame: the target moves down the frame by the change from the present lean."""
+        tan_v = self._tan_v(det)
+        edge = det.error_y + (det.size / det.height if det.height else 0.0)
+        room_deg = math.degrees(math.atan(VIEW_EDGE * tan_v) - math.atan(edge * tan_v))
+        return (room_deg - self.lean.deg) / self.lean.deg_per_step
+
+    def _level_error_y(self, det: Detection) -> float:
+        """The target's vertical error as a level camera would see it: a forward lean (nose down) moves it up
+        the frame, a brake down; the height is corrected for where the target is, not for the lean."""
+        tan_v = self._tan_v(det)
+        return math.tan(math.atan(det.error_y * tan_v) + math.radians(self.lean.deg)) / tan_v
 
     def _decide(self, det: Detection | None) -> bytes | None:
         now = self._now()
         held = self._pitch_steps if now <= self._pitch_until_ms else 0.0
         self.momentum.advance(held, (now - self._last_ms) / 1000.0)
+        self.lean.advance(held, (now - self._last_ms) / 1000.0)
         self._last_ms = now
         if det is not None and det.found and self.state in LOCKED:
             self.closing.update(now / 1000.0, det.range_m)
@@ -147,9 +176,28 @@ class Controller(ControllerCore):
         if self._pan_offset or self._tilt_offset:
             self._pan_offset = self._tilt_offset = 0
             return self._emit(dp.servo_reset())
+        step = self._search_step(self._now() - self._search_started_ms)
+        if step is not None:
+            return self._emit(step)
         if self._search_sign > 0:
             return self._emit(dp.turn_right(speed_for(dp.CommandName.TURN_RIGHT, 1.0)))
         return self._emit(dp.turn_left(speed_for(dp.CommandName.TURN_LEFT, 1.0)))
+
+    def _search_step(self, elapsed_ms: int) -> bytes | None:
+        """The height change due this far into the sweep (None: turn): after each leg one step down, then two
+        up, two down..., so the legs sweep at the start height, one step below it, one above it..."""
+        leg, step = self.cfg.search_leg_ms, self.cfg.search_step_ms
+        t, k = elapsed_ms, 0
+        while t >= leg:
+            t -= leg
+            moving = step if k == 0 else 2 * step
+            if t < moving:
+                if k % 2 == 0:
+                    return dp.move_down(speed_for(dp.CommandName.MOVE_DOWN, 1.0))
+                return dp.move_up(speed_for(dp.CommandName.MOVE_UP, 1.0))
+            t -= moving
+            k += 1
+        return None
 
     def _lost(self, det: Detection | None, limit: int) -> bool:
         if self._found(det):
@@ -197,7 +245,7 @@ class Controller(ControllerCore):
         if self._pan_offset or self._tilt_offset:
             self._pan_offset = self._tilt_offset = 0
             return self._emit(dp.servo_reset())
-        ex, ey, size = det.error_x, det.error_y, det.relative_size
+        ex, ey, size = det.error_x, self._level_error_y(det), det.relative_size
         self._remember_side(det)
         if size >= cfg.approach_size:  # close enough whatever else is off: AIM centres it with the servos
             self._go(State.AIM, f"close enough (size {size:.3f})")
@@ -208,7 +256,7 @@ class Controller(ControllerCore):
             allowed = allowed_speed(det.range_m * (1.0 - size / cfg.approach_size), cfg.brake_mps2,
                                     cfg.approach_speed_mps)
             if closing > allowed + 0.15:  # braking comes before any other correction
-                return self._brake(closing - allowed)
+                return self._brake(closing - allowed, det)
         if abs(ex) > cfg.dead_band_x:
             frac = 0.35 + 0.65 * min(1.0, abs(ex) / 0.5)
             if ex > 0:
@@ -232,9 +280,9 @@ class Controller(ControllerCore):
 
     def _servo_correction(self, det: Detection) -> bytes | None:
         """One pan or tilt step towards the target, the larger error first; None when centred."""
-        ex, ey = det.error_x, det.error_y
+        ex, ey = det.error_x, det.error_y  # the laser is on the mount: where it points is the frame's centre
         tol = self.cfg.aim_tolerance
-        tan_v = self._tan_h * (det.height / det.width) if det.width else self._tan_h
+        tan_v = self._tan_v(det)
         if abs(ex) <= tol and abs(ey) <= tol:
             return None
         if abs(ex) >= abs(ey):
@@ -266,11 +314,15 @@ class Controller(ControllerCore):
             self._centred = 0
             closing = self.closing.closing
             if closing is None or closing > -HOLD_MPS:
-                return self._brake(max(0.0, closing or 0.0))
-        hold = self._hold_range()
+                return self._brake(max(0.0, closing or 0.0), det)
+        hold = self._hold_range(det)
         if hold is not None:  # still coasting in (or drifting away): that first
             self._centred = 0
             return hold
+        if det.predicted:
+            # bridged, not seen: the prediction knows nothing of the servo step just sent (whose swing may be what
+            # blurred the target away), so another step from it would repeat that one
+            return self._emit(dp.hold_altitude())
         correction = self._servo_correction(det)
         if correction is not None:
             self._centred = 0
@@ -317,5 +369,5 @@ class Controller(ControllerCore):
         correction = self._servo_correction(det)
         if correction is not None:
             return correction
-        hold = self._hold_range()
+        hold = self._hold_range(det)
         return hold if hold is not None else self._emit(dp.hold_altitude())

@@ -4,13 +4,14 @@ range near the target, and braking by dead reckoning when the target is lost whi
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import drone_protocol as dp
 import pytest
-from controller_rig import CFG, MISS, name, seen, st, to_state
+from controller_rig import CFG, MISS, H, name, seen, st, to_state
 
-from pilot.approach import ClosingSpeed, allowed_speed
-from pilot.controller import State
+from pilot.approach import ClosingSpeed, Lean, allowed_speed
+from pilot.controller import MIN_BRAKE, State
 from pilot.detection import range_of
 
 W = 320
@@ -75,3 +76,51 @@ def test_lost_while_closing_brakes_before_the_search_turns() -> None:
     turns = [name(rig.tick(MISS)) for _ in range(60)]
     assert turns[-1] in ("turn_left", "turn_right")  # ... then the sweep
     assert dp.COMMANDS[dp.CommandName.MOVE_BACKWARD].target == "pitch"
+
+
+def test_the_lean_follows_the_pitch_stick_with_a_lag() -> None:
+    lean = Lean(CFG.pitch_accel_mps2)
+    assert lean.deg_per_step == pytest.approx(math.degrees(math.atan(CFG.pitch_accel_mps2 / 9.81)))
+    lean.advance(2.0, lean.lag_s)
+    assert lean.deg == pytest.approx(2.0 * lean.deg_per_step * (1.0 - math.exp(-1.0)))
+    for _ in range(40):  # 2 s: ten lags
+        lean.advance(-1.0, 0.05)
+    assert lean.deg == pytest.approx(-lean.deg_per_step, abs=0.01)
+
+
+def image_ey(angle_deg: float) -> float:
+    """The vertical error of a target ``angle_deg`` below the camera's axis (negative: above)."""
+    tan_v = math.tan(math.radians(CFG.horizontal_fov_deg) / 2.0) * H / W
+    return math.tan(math.radians(angle_deg)) / tan_v
+
+
+def test_track_does_not_climb_after_a_target_the_forward_lean_raised() -> None:
+    """Flying forward pitches the nose, and the camera, down: the target rises in the frame by the lean, and
+    the height is corrected for where the target is, not for the lean."""
+    _c, rig = to_state(State.TRACK)
+    raised = seen(0.0, image_ey(-7.0), size=0.05)
+    assert name(rig.tick(raised)) == "move_up"  # level: 7° above the axis is too high
+    c, rig = to_state(State.TRACK)
+    for _ in range(10):  # approaching a target level with the camera: it shows above the axis by the lean
+        assert name(rig.tick(seen(0.0, image_ey(-c.lean.deg), size=0.05))) == "move_forward"
+    assert c.lean.deg > 7.0
+    assert name(rig.tick(raised)) == "move_forward"
+
+
+def brake_us(ey: float) -> int:
+    c, rig = to_state(State.AIM, dataclasses.replace(CFG, aim_frames=100))
+    r, out = 1.3, None
+    for _ in range(6):
+        r -= 0.05  # 1 m/s closer
+        out = rig.tick(seen(0.0, ey, size=size_at(r)))
+    assert st(c) is State.AIM and name(out) == "move_backward"
+    return abs(dp.decode(out or b"").value or 0)
+
+
+def test_a_brake_keeps_a_low_target_in_the_frame() -> None:
+    """A brake pitches the nose up and the target down the frame: near the frame's lower edge it brakes
+    gentler (never below the gentlest brake) rather than lose it."""
+    median = dp.CHANNELS[dp.ChannelName.PITCH].median
+    centred, low = median - brake_us(0.0), median - brake_us(0.5)
+    assert 0 < low < centred
+    assert low >= round(MIN_BRAKE * dp.SPEED_STEP_US)

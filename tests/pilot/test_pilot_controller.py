@@ -3,6 +3,8 @@ drone that answers with the spec's status (tests/pilot/controller_rig.py)."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import drone_protocol as dp
 import pytest
 from controller_rig import CFG, MISS, Rig, land_to_done, name, seen, st, to_state
@@ -74,10 +76,33 @@ def test_search_is_bounded_then_lands() -> None:
         out = rig.tick(MISS, ms=100)
         n += 1
         if st(c) is State.SEARCH:
-            assert name(out) == "turn_right"
+            assert name(out) in ("turn_right", "move_down", "move_up")
     assert st(c) is State.LAND
     assert abs(n * 100 - CFG.search_max_ms) <= 100
     assert c.transitions[-1].reason == "search sweep exhausted"
+
+
+def test_search_sweeps_again_one_step_lower_then_one_step_higher() -> None:
+    """Something in front of the target may hide it from one height: each leg of the sweep is flown at
+    another (start, one step below, one step above), with full-stick climbs and descents between."""
+    cfg = dataclasses.replace(CFG, search_max_ms=4 * CFG.search_leg_ms)
+    c, rig = to_state(State.SEARCH, cfg)
+    runs: list[tuple[str, int]] = []  # (command, ms) in the order sent, equal neighbours merged
+    while True:
+        out = name(rig.tick(MISS, ms=50))
+        if st(c) is not State.SEARCH:
+            break
+        if runs and runs[-1][0] == out:
+            runs[-1] = (out, runs[-1][1] + 50)
+        else:
+            runs.append((out, 50))
+    legs = [(cmd, ms) for cmd, ms in runs if cmd != "turn_right"]
+    step = cfg.search_step_ms
+    assert [cmd for cmd, _ in legs] == ["move_down", "move_up", "move_down"]
+    for (_, ms), want in zip(legs, (step, 2 * step, 2 * step), strict=True):
+        assert abs(ms - want) <= 50
+    turns = [ms for cmd, ms in runs if cmd == "turn_right"]
+    assert all(abs(ms - cfg.search_leg_ms) <= 100 for ms in turns[1:-1])  # whole legs between the steps
 
 
 def test_acquire_needs_consecutive_frames() -> None:
@@ -124,7 +149,8 @@ def test_unconfirmed_sightings_do_not_extend_the_sweep() -> None:
         (0.0, -0.5, "move_up"),
         (0.0, 0.5, "move_down"),
         (0.0, 0.0, "move_forward"),
-        (CFG.dead_band_x * 0.9, CFG.dead_band_y * 0.9, "move_forward"),  # inside both dead bands
+        # inside both dead bands (above the axis: the forward lean the rig's last frame set raises a target)
+        (CFG.dead_band_x * 0.9, -CFG.dead_band_y * 0.9, "move_forward"),
         (0.4, 0.5, "turn_right"),  # yaw first
     ],
 )
@@ -172,6 +198,18 @@ def test_track_to_aim_with_size_hysteresis() -> None:
     assert st(c) is State.AIM  # hysteresis: stays
     out = rig.tick(seen(size=CFG.retreat_size * 0.95))
     assert st(c) is State.TRACK and name(out) == "move_forward"
+
+
+def test_aim_steps_the_servos_only_on_measured_sightings() -> None:
+    """A servo step's swing can blur the target away for a frame or two: the tracker's prediction through them
+    knows nothing of the step, so acting on it would repeat the step (and overshoot)."""
+    c, rig = to_state(State.AIM)
+    low = seen(0.0, 0.3, size=0.25)
+    assert name(rig.tick(low)) == "servo_down"
+    bridged = dataclasses.replace(low, predicted=True, confidence=0.8)
+    assert [name(rig.tick(bridged)) for _ in range(2)] == ["hold_altitude"] * 2
+    assert st(c) is State.AIM
+    assert name(rig.tick(low)) == "servo_down"  # measured again: the step is repeated only if still needed
 
 
 def test_aim_backs_off_a_target_it_coasted_up_to_before_it_fires() -> None:
