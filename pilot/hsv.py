@@ -4,26 +4,25 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
 ``inRange`` on the frame):
 
 1. Search: the frame at half resolution (from 320 px wide up; a 16 px target is still 8 px there),
-   one ``cvtColor``, one ``inRange``, a 3x3 opening, external contours; blobs filling too little of
-   their box's disc (``SEARCH_FILL``) are not refined. Red wraps around hue 0, which would need two
-   ranges; converting the BGR frame as if it were RGB mirrors the hue circle (h -> 120 - h, in OpenCV's
-   0..179 units) and puts red at 120, in one piece. The value (V) bound follows the frame's exposure: in
-   a frame whose brightest pixels are dim, it drops in proportion (never below ``V_FLOOR``), so that a
+   one ``cvtColor``, one ``inRange``, a 3x3 opening, external contours. Red wraps around hue 0, which would
+   need two ranges; converting the BGR frame as if it were RGB mirrors the hue circle (h -> 120 - h, in
+   OpenCV's 0..179 units) and puts red at 120, in one piece. The value (V) bound follows the frame's exposure:
+   in a frame whose brightest pixels are dim, it drops in proportion (never below ``V_FLOOR``), so that a
    ball's shaded side stays in the mask and the fitted circle stays on the ball.
-2. Refine: the few largest blobs are looked at again at full resolution, in a window around each: a 3x3
-   median (sensor noise in a ball's shaded side would fray its outline), mask, 3x3 opening and closing,
-   the blob's contours, and a score 0..1 each, a product of ramps each between a value no target shows
-   and one every target shows (chosen on the tuning photos of bench/vision); measuring stops as soon as
-   the geometry alone scores below ``hsv.min_score``:
+2. Refine: the few largest blobs filling at least ``SEARCH_FILL`` of their box's disc are looked at again at
+   full resolution, in a window around each: a 3x3 median (sensor noise in a ball's shaded side would fray
+   its outline), mask, 3x3 opening and closing, the blob's contours, and a score 0..1 each, a product of
+   ramps each between a value no target shows and one every target shows (chosen on the tuning photos of
+   bench/vision); measuring stops as soon as the product so far is below ``hsv.min_score``:
 
    * shape: the share of the contour lying on its minimum enclosing circle ("arc support": a disk ~1, a
      disk with 30 % hidden behind an edge ~0.7, a square ~0.3), solidity, fill of that circle, and the
      aspect of its minimum-area rectangle (a rotated bar has a square bounding box).
    * colour purity: mean saturation, and how far the mean hue sits from the middle of the range (orange
      and red-brown sit near its edge, the target's red in the middle).
-   * isolation: the share of the ring around the circle (1.25 to 1.75 radii) that is of the target's
-     colour: a ball stands apart; a hole in a red poster's print, a piece of a red box or of a brick wall
-     does not.
+   * isolation: the share of the ring around the circle (1.25 to 1.75 radii, sampled) that is of the
+     target's colour: a ball stands apart; a hole in a red poster's print, a piece of a red box or of a brick
+     wall does not.
    * size: the range the apparent diameter implies (known diameter, field of view) must be plausible, and
      a blob under 16 px is scored down (too few pixels to show its shape).
 
@@ -53,15 +52,35 @@ V_REFERENCE = 200.0  # brightness (see _exposure) of a well-exposed frame; the V
 V_FLOOR = 24  # the V bound never drops below this: under it hue and saturation are noise
 # score ramps (zero, one), set on the tuning photos only (bench/vision/RESULTS.md)
 ARC = (0.3, 0.6)
+ARC_TOL = 0.12  # a contour point within this share of the radius (at least 1.5 px) lies on the circle
 SOLIDITY = (0.7, 0.88)
 FILL = (0.35, 0.6)
 ELONGATION = (2.0, 1.4)  # minimum-area rectangle, longer side over shorter (falling ramp)
-HUE_OFF = (0.5, 0.95)  # mean hue's distance from the range's middle, in half-widths
+SATURATION = (10.0, 60.0)  # mean saturation above the S bound (pink and pale red sit just over it)
+HUE_OFF = (0.6, 1.0)  # mean hue's distance from the range's middle, in half-widths
 RING = (0.35, 0.1)  # share of the ring of the target's colour (falling ramp)
 SIZE = (8.0, 16.0)  # diameter, pixels: a smaller blob has too few pixels to show its shape
 
 
 Bounds = list[tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]]  # inRange's lower and upper HSV triples
+# the ring from 1.25 to 1.75 radii, in radii: three circles of 48 points (sampling it costs a third of drawing it)
+_ANGLES = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
+_RING_POINTS = np.concatenate([k * np.stack([np.cos(_ANGLES), np.sin(_ANGLES)], axis=1) for k in (1.33, 1.5, 1.67)])
+
+
+def _share_set(mask: MatLike, cx: float, cy: float, unit: npt.NDArray[np.float64], r: float) -> float:
+    """The share of the points ``unit * r`` (offsets from cx, cy; at most 1.7 r away) inside the mask's frame that
+    are set in it."""
+    h, w = mask.shape[:2]
+    pos = unit * r + (cx + 0.5, cy + 0.5)  # + 0.5: truncation rounds
+    reach = 1.7 * r + 1.0
+    if reach <= cx < w - reach and reach <= cy < h - reach:  # all inside: the usual case
+        idx = pos.astype(np.intp)
+    else:
+        idx = pos[(pos[:, 0] >= 0.0) & (pos[:, 0] < w) & (pos[:, 1] >= 0.0) & (pos[:, 1] < h)].astype(np.intp)
+        if not len(idx):
+            return 1.0
+    return float(np.count_nonzero(np.asarray(mask)[idx[:, 1], idx[:, 0]])) / len(idx)
 
 
 class Features(NamedTuple):
@@ -129,7 +148,7 @@ class HsvBlobDetector:
     # -- masks --------------------------------------------------------------------------------------
     def _exposure(self, image: MatLike) -> float:
         """The frame's brightness: a high order statistic of every channel on a sparse grid (a few µs)."""
-        step = max(4, image.shape[1] // 40)  # about 40x30 samples at any frame size
+        step = max(4, image.shape[1] // 24)  # about 24x18 samples at any frame size
         grid = np.asarray(image[::step, ::step]).reshape(-1)
         k = max(1, grid.size // 50)  # the 98th percentile, without a sort
         return float(np.partition(grid, grid.size - k)[grid.size - k])
@@ -185,11 +204,10 @@ class HsvBlobDetector:
             x, y, bw, bh = cv2.boundingRect(c)
             # a blob filling less than SEARCH_FILL of its box's disc cannot hold a ball the refinement would take
             if area >= SEARCH_FILL * math.pi * (max(bw, bh) / 2.0) ** 2:
-                boxes.append((area, (x, y, bw, bh)))
+                boxes.append((area, (x * scale, y * scale, bw * scale, bh * scale)))
         boxes.sort(key=lambda b: b[0], reverse=True)
         found: list[Features] = []
-        for _, (x, y, bw, bh) in boxes[:MAX_CANDIDATES]:
-            box = (x * scale, y * scale, bw * scale, bh * scale)
+        for _, box in boxes[:MAX_CANDIDATES]:
             for f in self._refine(image, bounds, box):
                 if all(abs(f.cx - g.cx) > 1.0 or abs(f.cy - g.cy) > 1.0 for g in found):
                     found.append(f)
@@ -213,7 +231,7 @@ class HsvBlobDetector:
         return [f for f in found if f is not None]
 
     def _measure(self, hsv: MatLike, mask: MatLike, c: MatLike, area: float, x0: int, y0: int) -> Features | None:
-        """The blob's features; None as soon as its geometry alone scores below ``min_score``."""
+        """The blob's features; None as soon as the product of its factors so far is below ``min_score``."""
         (cx, cy), r = cv2.minEnclosingCircle(c)
         size = 2.0 * r + 1.0  # the circle passes through pixel centres; the ball covers the pixels
         (_, _), (rw, rh), _ = cv2.minAreaRect(c)
@@ -223,25 +241,28 @@ class HsvBlobDetector:
         geometry *= _ramp(elongation, *ELONGATION)
         if geometry <= 0.0 or geometry < self.cfg.min_score:
             return None
-        pts = np.asarray(c, np.float32).reshape(-1, 2)
-        gap = np.abs(np.hypot(pts[:, 0] - cx, pts[:, 1] - cy) - r)
-        arc = float(np.count_nonzero(gap <= max(1.5, 0.12 * r))) / len(pts)
+        # the ring from 1.25 to 1.75 radii, sampled: outside the blob's circle, so the mask there is something else
+        ring = _share_set(mask, cx, cy, _RING_POINTS, max(r, 2.0))
+        geometry *= _ramp(ring, *RING)
+        if geometry <= 0.0 or geometry < self.cfg.min_score:
+            return None
+        pts = c.reshape(-1, 2)
+        d2 = np.square(pts - (cx, cy)).sum(axis=1)
+        tol = max(1.5, ARC_TOL * r)
+        on_arc = (d2 >= (r - tol) ** 2) & (d2 <= (r + tol) ** 2)
+        arc = float(np.count_nonzero(on_arc)) / len(pts)
         hull = float(cv2.contourArea(cv2.convexHull(c)))
         solidity = area / hull if hull > 0 else 0.0
         geometry *= _ramp(arc, *ARC) * _ramp(solidity, *SOLIDITY)
         if geometry <= 0.0 or geometry < self.cfg.min_score:
             return None
-        blob = np.zeros_like(mask)
-        cv2.drawContours(blob, [c], 0, 255, -1)
-        mean = cv2.mean(hsv, mask=cv2.bitwise_and(mask, blob))
-        ring = np.zeros_like(mask)
-        # the ring from 1.25 to 1.75 radii (a circle of radius 1.5 r, 0.5 r thick), centre to 1/16 px
-        cv2.circle(ring, (round(cx * 16), round(cy * 16)), round(24 * r), 255, max(2, round(0.5 * r)), cv2.LINE_8, 4)
-        ring_px = cv2.countNonZero(ring)
-        other = cv2.countNonZero(cv2.bitwise_and(ring, cv2.bitwise_and(mask, cv2.bitwise_not(blob))))
+        # colour: the mean over the blob's box (the mask's pixels there are the blob's, or nearly)
+        bx, by, bw, bh = cv2.boundingRect(c)
+        box = (slice(by, by + bh), slice(bx, bx + bw))
+        mean = cv2.mean(hsv[box], mask=mask[box])
         return Features(
             cx + x0, cy + y0, size, arc, solidity, fill, elongation, float(mean[1]),
-            abs(float(mean[0]) - self._hue_mid) / self._hue_half, other / ring_px if ring_px else 1.0,
+            abs(float(mean[0]) - self._hue_mid) / self._hue_half, ring,
         )
 
     def _size_score(self, size: float, width: int) -> float:
@@ -253,7 +274,8 @@ class HsvBlobDetector:
     def score(self, f: Features, width: int) -> float:
         shape = _ramp(f.arc, *ARC) * _ramp(f.solidity, *SOLIDITY) * _ramp(f.fill, *FILL)
         shape *= _ramp(f.elongation, *ELONGATION) * self._size_score(f.size, width)
-        colour = _ramp(f.saturation, self._sat_lo, self._sat_lo + 50.0) * (1.0 - _ramp(f.hue_off, *HUE_OFF))
+        colour = _ramp(f.saturation, self._sat_lo + SATURATION[0], self._sat_lo + SATURATION[1])
+        colour *= 1.0 - _ramp(f.hue_off, *HUE_OFF)
         return shape * colour * _ramp(f.ring, *RING)
 
     def candidates(self, image: MatLike) -> list[Candidate]:

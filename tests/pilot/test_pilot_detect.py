@@ -3,6 +3,7 @@ from __future__ import annotations
 import itertools
 
 import cv2
+import numpy as np
 import pilot_synth as synth
 import pytest
 
@@ -60,6 +61,24 @@ def test_hsv_no_detection_with_only_distractors(width: int, height: int, gain: f
     img = synth.degrade(img, gain, 6.0, seed=3)
     d = det.detect(img)
     assert not d.found, d
+
+
+@pytest.mark.parametrize(
+    "hue,sat,lo,hi",
+    [
+        (0, 210, 0.95, 1.0),  # the range's middle, saturated
+        (4, 210, 0.6, 0.95),  # two thirds out to the range's edge: scored down, still acquired
+        (176, 210, 0.6, 0.95),
+        (4, 150, 0.0, 0.6),  # off-middle and pale (pink, faded red): not acquired
+        (0, 135, 0.0, 0.2),  # just over the saturation bound: not reported
+    ],
+)
+def test_hsv_colour_purity(hue: int, sat: int, lo: float, hi: float) -> None:
+    bgr = cv2.cvtColor(np.array([[[hue, sat, 210]]], np.uint8), cv2.COLOR_HSV2BGR)[0, 0]
+    img = synth.background(320, 240)
+    cv2.circle(img, (160, 120), 20, tuple(int(v) for v in bgr), -1, lineType=cv2.LINE_AA)
+    d = HsvBlobDetector(HsvConfig()).detect(img)
+    assert lo <= d.confidence <= hi, d
 
 
 def test_hsv_both_hue_ranges_are_needed() -> None:
@@ -122,8 +141,6 @@ def test_aruco_ignores_other_ids_and_distractors() -> None:
 def test_one_inrange_on_the_mirrored_hue_equals_one_inrange_per_range() -> None:
     """Red's two ranges become one range at hue 120 when the BGR frame is converted as RGB: the same mask,
     but for pixels whose hue sits on a range boundary (rounding of the mirrored hue)."""
-    import numpy as np
-
     cfg = HsvConfig()
     fast = HsvBlobDetector(cfg)
     assert fast.single_range
