@@ -79,7 +79,6 @@ class ControllerConfig:
     # something in front of the target may hide it from one height (down one step first, then up past the start)
     search_leg_ms: int = 7500
     search_step_ms: int = 800  # the climb or descent between legs (full stick)
-    search_look_ms: int = 2000  # a target lost inside the view is looked for there this long before the sweep
     # how long LAND waits for the drone to confirm it landed and disarmed (the firmware's landing routine and
     # disarm sequence, plus room for lost frames); then the pilot stops sending and the failsafe takes over
     land_ms: int = dp.LANDING_MS + dp.ARMING_HOLD_MS + 2000
@@ -190,7 +189,6 @@ RANGES: dict[str, tuple[float, float]] = {
     "controller.search_max_ms": (1, 600_000),
     "controller.search_leg_ms": (1000, 600_000),
     "controller.search_step_ms": (0, 5_000),
-    "controller.search_look_ms": (0, 60_000),
     "controller.land_ms": (_LAND_MIN_MS, 600_000),  # the firmware's landing and disarm must fit
     "controller.arm_margin_ms": (0, 10_000),
     "controller.dead_band_x": (0.0, 1.0),

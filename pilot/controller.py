@@ -17,9 +17,9 @@ States (``State``)::
   state, then waits ``arm_margin_ms``; it gives up if no arming is confirmed in time.
 * TAKEOFF climbs (``move_up``) for ``takeoff_ms``; HOLD sends ``hold_altitude()`` for ``settle_ms``.
 * SEARCH turns (a bounded sweep: ``search_max_ms`` in all, unconfirmed sightings included, then LAND)
-  towards the side the target was last seen (lost inside the view, after ``search_look_ms`` looking there),
-  in legs of ``search_leg_ms`` (about a turn) flown at the start height, one ``search_step_ms`` climb below
-  it, one above it...: something in front may hide the target from one height.
+  towards the side the target was last seen, in legs of ``search_leg_ms`` (about a turn) flown at the start
+  height, one ``search_step_ms`` climb below it, one above it...: something in front may hide the target
+  from one height.
 * ACQUIRE stops turning and needs ``acquire_frames`` consecutive sightings to go on to TRACK; after
   ``lost_frames`` misses in a row it searches again.
 * TRACK corrects one axis per frame: yaw while the horizontal error is outside its dead band, then
@@ -64,7 +64,6 @@ STICK_CHANNELS = frozenset(c.value for c in dp.ChannelName)  # commands that mov
 HOLD_MPS = 0.12  # closing speeds within this are left alone near the target (the estimate's noise)
 VIEW_EDGE = 0.9  # a brake's lean keeps the target's lower edge above this share of the frame's lower half
 MIN_BRAKE = 0.4  # speed steps: the gentlest brake, whatever the view allows
-LOOK_BEARING = 0.7  # lost within this share of the half field of view: look there first
 
 
 class Controller(ControllerCore):
@@ -79,8 +78,6 @@ class Controller(ControllerCore):
         self._last_ms = self._now()
         self._brake_until_ms = 0  # target lost while closing in: brake this long before searching
         self._brake_speed = 0.0
-        self._look_until_ms = 0  # target lost inside the view: hold and look before the sweep turns
-        self._last_bearing_deg = 0.0
 
     def _hold_range(self, det: Detection) -> bytes | None:
         """Near the target nothing holds position but the pilot: brake a closing speed, nudge forward against a
@@ -173,11 +170,6 @@ class Controller(ControllerCore):
             return self._on_acquire(det)
         if self._now() < self._brake_until_ms:
             return self._brake(self._brake_speed)
-        if self._now() < self._look_until_ms:  # lost inside the view: look where it was before turning away
-            if self._pan_offset or self._tilt_offset:
-                self._pan_offset = self._tilt_offset = 0
-                return self._emit(dp.servo_reset())
-            return self._emit(dp.hold_altitude())
         if self._now() - self._search_started_ms >= self.cfg.search_max_ms:
             self._go(State.LAND, "search sweep exhausted")
             return self._on_land(det)
@@ -222,9 +214,6 @@ class Controller(ControllerCore):
         if closing > 0.15:
             self._brake_until_ms = self._now() + round(1000.0 * closing / self.cfg.brake_mps2)
             self._brake_speed = closing
-        if abs(self._last_bearing_deg) < LOOK_BEARING * self.cfg.horizontal_fov_deg / 2.0:
-            # it vanished inside the view (hidden for a moment, blurred, a lost lock): it is most likely still there
-            self._look_until_ms = max(self._now(), self._brake_until_ms) + self.cfg.search_look_ms
         self._go(State.SEARCH, reason)
         return off if off is not None else self._emit(dp.hold_altitude())
 
@@ -288,7 +277,6 @@ class Controller(ControllerCore):
         """Which way to sweep if the target is lost: its bearing from the body (camera pan included)."""
         bearing = self._pan_offset + math.degrees(math.atan(det.error_x * self._tan_h))
         self._search_sign = 1 if bearing >= 0 else -1
-        self._last_bearing_deg = bearing
 
     def _servo_correction(self, det: Detection) -> bytes | None:
         """One pan or tilt step towards the target, the larger error first; None when centred."""

