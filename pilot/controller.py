@@ -24,9 +24,8 @@ States (``State``)::
   ``lost_frames`` misses in a row it searches again.
 * TRACK corrects one axis per frame: yaw while the horizontal error is outside its dead band, then
   height while the vertical error is, else forward until the apparent size reaches ``approach_size``.
-  The camera leans with the airframe (``Lean``, estimated from the pitch commands): the height is corrected
-  for the error a level camera would see, and a brake is never so hard that its lean drops the target out of
-  the frame.
+  The camera leans with the airframe (``Lean``, estimated from the pitch commands): a brake is never so hard
+  that its lean drops the target out of the frame.
   AIM begins there and returns to TRACK only below ``retreat_size`` (hysteresis); above ``back_off_size`` it
   backs off before it fires. Up to ``coast_frames`` missed frames during a forward approach keep it going (a
   far target flickers in and out of detection).
@@ -107,12 +106,6 @@ class Controller(ControllerCore):
         edge = det.error_y + (det.size / det.height if det.height else 0.0)
         room_deg = math.degrees(math.atan(VIEW_EDGE * tan_v) - math.atan(edge * tan_v))
         return (room_deg - self.lean.deg) / self.lean.deg_per_step
-
-    def _level_error_y(self, det: Detection) -> float:
-        """The target's vertical error as a level camera would see it: a forward lean (nose down) moves it up
-        the frame, a brake down; the height is corrected for where the target is, not for the lean."""
-        tan_v = self._tan_v(det)
-        return math.tan(math.atan(det.error_y * tan_v) + math.radians(self.lean.deg)) / tan_v
 
     def _decide(self, det: Detection | None) -> bytes | None:
         now = self._now()
@@ -245,7 +238,7 @@ class Controller(ControllerCore):
         if self._pan_offset or self._tilt_offset:
             self._pan_offset = self._tilt_offset = 0
             return self._emit(dp.servo_reset())
-        ex, ey, size = det.error_x, self._level_error_y(det), det.relative_size
+        ex, ey, size = det.error_x, det.error_y, det.relative_size
         self._remember_side(det)
         if size >= cfg.approach_size:  # close enough whatever else is off: AIM centres it with the servos
             self._go(State.AIM, f"close enough (size {size:.3f})")
@@ -280,7 +273,7 @@ class Controller(ControllerCore):
 
     def _servo_correction(self, det: Detection) -> bytes | None:
         """One pan or tilt step towards the target, the larger error first; None when centred."""
-        ex, ey = det.error_x, det.error_y  # the laser is on the mount: where it points is the frame's centre
+        ex, ey = det.error_x, det.error_y
         tol = self.cfg.aim_tolerance
         tan_v = self._tan_v(det)
         if abs(ex) <= tol and abs(ey) <= tol:

@@ -8,7 +8,7 @@ import math
 
 import drone_protocol as dp
 import pytest
-from controller_rig import CFG, MISS, H, name, seen, st, to_state
+from controller_rig import CFG, MISS, name, seen, st, to_state
 
 from pilot.approach import ClosingSpeed, Lean, allowed_speed
 from pilot.controller import MIN_BRAKE, State
@@ -86,25 +86,6 @@ def test_the_lean_follows_the_pitch_stick_with_a_lag() -> None:
     for _ in range(40):  # 2 s: ten lags
         lean.advance(-1.0, 0.05)
     assert lean.deg == pytest.approx(-lean.deg_per_step, abs=0.01)
-
-
-def image_ey(angle_deg: float) -> float:
-    """The vertical error of a target ``angle_deg`` below the camera's axis (negative: above)."""
-    tan_v = math.tan(math.radians(CFG.horizontal_fov_deg) / 2.0) * H / W
-    return math.tan(math.radians(angle_deg)) / tan_v
-
-
-def test_track_does_not_climb_after_a_target_the_forward_lean_raised() -> None:
-    """Flying forward pitches the nose, and the camera, down: the target rises in the frame by the lean, and
-    the height is corrected for where the target is, not for the lean."""
-    _c, rig = to_state(State.TRACK)
-    raised = seen(0.0, image_ey(-7.0), size=0.05)
-    assert name(rig.tick(raised)) == "move_up"  # level: 7° above the axis is too high
-    c, rig = to_state(State.TRACK)
-    for _ in range(10):  # approaching a target level with the camera: it shows above the axis by the lean
-        assert name(rig.tick(seen(0.0, image_ey(-c.lean.deg), size=0.05))) == "move_forward"
-    assert c.lean.deg > 7.0
-    assert name(rig.tick(raised)) == "move_forward"
 
 
 def brake_us(ey: float) -> int:

@@ -149,8 +149,7 @@ def test_unconfirmed_sightings_do_not_extend_the_sweep() -> None:
         (0.0, -0.5, "move_up"),
         (0.0, 0.5, "move_down"),
         (0.0, 0.0, "move_forward"),
-        # inside both dead bands (above the axis: the forward lean the rig's last frame set raises a target)
-        (CFG.dead_band_x * 0.9, -CFG.dead_band_y * 0.9, "move_forward"),
+        (CFG.dead_band_x * 0.9, CFG.dead_band_y * 0.9, "move_forward"),  # inside both dead bands
         (0.4, 0.5, "turn_right"),  # yaw first
     ],
 )
