@@ -88,9 +88,7 @@ class Lean:
         self.lag_s = lag_s
         self.deg = 0.0
 
-    def reset(self) -> None:
-        self.deg = 0.0
-
     def advance(self, pitch_steps: float, dt: float) -> None:
+        """``pitch_steps``: the pitch stick held during ``dt`` (its lean follows whatever the state: no reset)."""
         if dt > 0.0:
             self.deg += (self.deg_per_step * pitch_steps - self.deg) * (1.0 - math.exp(-dt / self.lag_s))
