@@ -11,11 +11,11 @@ from __future__ import annotations
 import dataclasses
 import multiprocessing
 import time
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..config import PilotConfig
+from ..config import LinkConfig, PilotConfig
 from ..controller import Controller, State
 from ..detect import make_detector
 from ..link import Link, LogEntry, keepalive_ms
@@ -92,6 +92,28 @@ class FlightJob:
     fault: str | None = None  # a camera fault, KIND@START+DURATION (world.CameraFault)
 
 
+def sim_link(
+    world: SimWorld, vd: VirtualDrone, cfg: LinkConfig, log: Callable[[LogEntry], None] | None = None
+) -> Link:
+    """The pilot's link to the virtual drone's pty, stamped with the world's clock and made the world's step
+    barrier (both ways, so a flight is deterministic under any load); not yet open."""
+    link = Link(
+        vd.pty,
+        ready_timeout_s=cfg.ready_timeout_s,
+        reconnect_s=cfg.reconnect_s,
+        clock=world.now,
+        log=log,
+        # opening the pty reboots the virtual board: run it for BOOT_MS (it sends its ready line well within),
+        # then wait in real time for the kernel to move the bytes through the pty, so that the flight's
+        # simulated timeline does not depend on that
+        on_open=lambda: world.advance(BOOT_MS),
+        ready_clock=time.monotonic,
+        ready_sleep=time.sleep,
+    )
+    world.link = link
+    return link
+
+
 def fly(
     scenario_name: str,
     seed: int,
@@ -135,20 +157,7 @@ def fly(
                 if recorder is not None:
                     recorder.on_link(entry)
 
-            link = Link(
-                vd.pty,
-                ready_timeout_s=cfg.link.ready_timeout_s,
-                reconnect_s=cfg.link.reconnect_s,
-                clock=world.now,
-                log=link_log,
-                # opening the pty reboots the virtual board: run it for BOOT_MS (it sends its ready line
-                # well within), then wait in real time for the kernel to move the bytes through the pty,
-                # so that the flight's simulated timeline does not depend on that
-                on_open=lambda: world.advance(BOOT_MS),
-                ready_clock=time.monotonic,
-                ready_sleep=time.sleep,
-            )
-            world.link = link  # every step a barrier on the pty, both ways: deterministic under any load
+            link = sim_link(world, vd, cfg.link, link_log)
             with link:
                 controller = Controller(cfg.controller, clock=world.now)
                 watchers: list[Observer] = list(observers)

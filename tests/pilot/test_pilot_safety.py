@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import dataclasses
 import signal
-import time
 from pathlib import Path
 
 import drone_protocol as dp
@@ -19,9 +18,10 @@ from pilot.controller import Controller, State
 from pilot.detect import Detection, HsvBlobDetector
 from pilot.link import Link, keepalive_ms
 from pilot.runner import RunResult, Tick, run
+from pilot.sim.flight import sim_link
 from pilot.sim.room import make_scenario
 from pilot.sim.virtual import VirtualDrone
-from pilot.sim.world import BOOT_MS, SimWorld
+from pilot.sim.world import SimWorld
 from pilot.sources import Frame
 
 REPO = Path(__file__).resolve().parents[2]
@@ -48,15 +48,7 @@ def fly_and_fault(stage: str, exe: Path) -> Flight:
     scenario = make_scenario("ahead", 1)
     vd = VirtualDrone(exe)
     world = SimWorld(scenario, vd)
-    link = Link(
-        vd.pty,
-        clock=world.now,
-        ready_clock=time.monotonic,
-        ready_sleep=time.sleep,
-        on_open=lambda: world.advance(BOOT_MS),
-    )
-    world.link = link
-    link.open()
+    link = sim_link(world, vd, cfg.link).open()
     controller = Controller(cfg.controller, clock=world.now)
     detector = HsvBlobDetector(cfg.hsv)
     camera = world.camera()
