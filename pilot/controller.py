@@ -110,8 +110,9 @@ class Controller(ControllerCore):
     def _decide(self, det: Detection | None) -> bytes | None:
         now = self._now()
         held = self._pitch_steps if now <= self._pitch_until_ms else 0.0
-        self.momentum.advance(held, (now - self._last_ms) / 1000.0)
-        self.lean.advance(held, (now - self._last_ms) / 1000.0)
+        dt = (now - self._last_ms) / 1000.0
+        self.momentum.advance(held, dt)
+        self.lean.advance(held, dt)
         self._last_ms = now
         if det is not None and det.found and self.state in LOCKED:
             self.closing.update(now / 1000.0, det.range_m)

@@ -64,8 +64,8 @@ def timing(repeat: int) -> list[str]:
         aruco = ArucoMarkerDetector()
         floor_ms, hsv_ms = times(frames, repeat, lambda im: cv2.inRange(cv2.cvtColor(im, cv2.COLOR_BGR2HSV), lo, hi),
                                  hsv.candidates)
-        floor, det, ar = statistics.median(floor_ms), statistics.median(hsv_ms), statistics.median(
-            times(frames, repeat, aruco.candidates)[0])
+        floor, det = statistics.median(floor_ms), statistics.median(hsv_ms)
+        ar = statistics.median(times(frames, repeat, aruco.candidates)[0])
         p90 = sorted(hsv_ms)[int(0.9 * len(hsv_ms))]
         rows.append(f"| {w}x{h} | {floor:.3f} | {det:.3f} | {det / floor:.2f}x | {p90:.3f} | {ar:.2f} |")
     return rows
