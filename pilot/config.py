@@ -95,6 +95,7 @@ class ControllerConfig:
     brake_mps2: float = 0.5  # deceleration the approach plans with (a 5° lean gives about 0.9 m/s²)
     approach_speed_mps: float = 0.6  # top closing speed
     pitch_accel_mps2: float = 0.8  # what one speed step of pitch does (a 5° lean), for dead reckoning
+    climb_mps_per_step: float = 0.47  # AltHold's climb rate for one speed step of throttle, for the height estimate
 
 
 @dataclass(frozen=True)
@@ -200,6 +201,7 @@ RANGES: dict[str, tuple[float, float]] = {
     "controller.brake_mps2": (0.05, 5.0),
     "controller.approach_speed_mps": (0.05, 3.0),
     "controller.pitch_accel_mps2": (0.05, 10.0),
+    "controller.climb_mps_per_step": (0.01, 5.0),
     "link.rate_hz": (1.0, 50.0),
     "link.keepalive_fraction": (0.01, 0.99),
     "link.ready_timeout_s": (0.1, 60.0),

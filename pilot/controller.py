@@ -19,13 +19,15 @@ States (``State``)::
 * SEARCH turns (a bounded sweep: ``search_max_ms`` in all, unconfirmed sightings included, then LAND)
   towards the side the target was last seen, in legs of ``search_leg_ms`` (about a turn) flown at the start
   height, one ``search_step_ms`` climb below it, one above it...: something in front may hide the target
-  from one height.
+  from one height. A search after a sighting first goes back to the height it was seen from (``SeenFrom``).
 * ACQUIRE stops turning and needs ``acquire_frames`` consecutive sightings to go on to TRACK; after
   ``lost_frames`` misses in a row it searches again.
 * TRACK corrects one axis per frame: yaw while the horizontal error is outside its dead band, then
   height while the vertical error is, else forward until the apparent size reaches ``approach_size``.
   The camera leans with the airframe (``Lean``, estimated from the pitch commands): a brake is never so hard
-  that its lean drops the target out of the frame.
+  that its lean drops the target out of the frame. A target lost after a climb (or descent) is hidden from
+  above (below): a ceiling (floor) just inside the height it was seen from bars the height correction while the
+  target stays near the frame's middle, and the approach goes on off-centre (``pilot.vertical``).
   AIM begins there and returns to TRACK only below ``retreat_size`` (hysteresis); above ``back_off_size`` it
   backs off before it fires. Up to ``coast_frames`` missed frames during a forward approach keep it going (a
   far target flickers in and out of detection).
@@ -56,13 +58,16 @@ from .config import ControllerConfig
 from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, speed_for
 from .detection import Detection
 from .gating import Gate
+from .sticks import HeldSticks
+from .vertical import Height, SeenFrom
 
 __all__ = ["FLYING", "LOCKED", "Controller", "State", "Transition"]
 
-STICK_CHANNELS = frozenset(c.value for c in dp.ChannelName)  # commands that move a stick
 HOLD_MPS = 0.12  # closing speeds within this are left alone near the target (the estimate's noise)
 VIEW_EDGE = 0.9  # a brake's lean keeps the target's lower edge above this share of the frame's lower half
 MIN_BRAKE = 0.4  # speed steps: the gentlest brake, whatever the view allows
+RETURN_TOL_M = 0.05  # a search's return to the height the target was seen from ends this close to it
+RETURN_MAX_MS = 3000  # ... or this long after the search began
 
 
 class Controller(ControllerCore):
@@ -72,8 +77,10 @@ class Controller(ControllerCore):
         self.closing = ClosingSpeed()
         self.momentum = Momentum(self.cfg.pitch_accel_mps2)
         self.lean = Lean(self.cfg.pitch_accel_mps2)
-        self._pitch_steps = 0.0  # the pitch stick the last command holds, in speed steps (forward positive)
-        self._pitch_until_ms = 0
+        self.height = Height(self.cfg.climb_mps_per_step)
+        self.seen_from = SeenFrom()
+        self._return_m: float | None = None  # a search first goes back to this height
+        self.sticks = HeldSticks()
         self._last_ms = self._now()
         self._brake_until_ms = 0  # target lost while closing in: brake this long before searching
         self._brake_speed = 0.0
@@ -109,10 +116,11 @@ class Controller(ControllerCore):
 
     def _decide(self, det: Detection | None) -> bytes | None:
         now = self._now()
-        held = self._pitch_steps if now <= self._pitch_until_ms else 0.0
+        held = self.sticks.pitch(now)
         dt = (now - self._last_ms) / 1000.0
         self.momentum.advance(held, dt)
         self.lean.advance(held, dt)
+        self.height.advance(self.sticks.throttle(now), dt)
         self._last_ms = now
         if det is not None and det.found and self.state in LOCKED:
             self.closing.update(now / 1000.0, det.range_m)
@@ -121,26 +129,10 @@ class Controller(ControllerCore):
             self.closing.reset()
             self.momentum.reset()
         frame = self._decide_frame(det)
-        self._held_pitch(frame)
+        if det is not None and self.gate.acquired() and not det.predicted:
+            self.seen_from.saw(self.height.m)
+        self.sticks.sent(frame, self._now())
         return frame
-
-    def _held_pitch(self, frame: bytes | None) -> None:
-        """What the firmware holds after this frame: a pitch command for its command timeout, any other
-        movement or a hold releases the pitch; a non-movement frame (servo, laser, status) changes nothing."""
-        if frame is None:
-            return
-        try:
-            command = dp.decode(frame)
-        except dp.ProtocolError:
-            return
-        channel = dp.COMMANDS[command.name].target
-        if channel == dp.ChannelName.PITCH.value:
-            median = dp.CHANNELS[dp.ChannelName.PITCH].median
-            sense = 1 if command.name is dp.CommandName.MOVE_FORWARD else -1
-            self._pitch_steps = sense * abs(int(command.value or median) - median) / dp.SPEED_STEP_US
-            self._pitch_until_ms = self._now() + dp.COMMAND_TIMEOUT_MS
-        elif channel in STICK_CHANNELS or command.name is dp.CommandName.HOLD_ALTITUDE:
-            self._pitch_steps = 0.0
 
     def _decide_frame(self, det: Detection | None) -> bytes | None:
         # -- vision gate (issue 12): a bad frame holds (laser off), too many in a row land ------------
@@ -170,12 +162,33 @@ class Controller(ControllerCore):
         if self._pan_offset or self._tilt_offset:
             self._pan_offset = self._tilt_offset = 0
             return self._emit(dp.servo_reset())
+        back = self._return_step()
+        if back is not None:
+            return self._emit(back)
         step = self._search_step(self._now() - self._search_started_ms)
         if step is not None:
             return self._emit(step)
         if self._search_sign > 0:
             return self._emit(dp.turn_right(speed_for(dp.CommandName.TURN_RIGHT, 1.0)))
         return self._emit(dp.turn_left(speed_for(dp.CommandName.TURN_LEFT, 1.0)))
+
+    def _go(self, new: State, reason: str) -> None:
+        if new is State.SEARCH and self.state is not State.SEARCH:
+            self.seen_from.lost(self.height.m)
+            self._return_m = self.seen_from.return_to()
+        super()._go(new, reason)
+
+    def _return_step(self) -> bytes | None:
+        """Before sweeping, back to the height the target was last seen from (a climb may have hidden it)."""
+        if self._return_m is None:
+            return None
+        off = self._return_m - self.height.settles_m
+        if abs(off) <= RETURN_TOL_M or self._elapsed() > RETURN_MAX_MS:
+            self._return_m = None
+            return None
+        if off > 0.0:
+            return dp.move_up(speed_for(dp.CommandName.MOVE_UP, 1.0))
+        return dp.move_down(speed_for(dp.CommandName.MOVE_DOWN, 1.0))
 
     def _search_step(self, elapsed_ms: int) -> bytes | None:
         """The height change due this far into the sweep (None: turn): after each leg one step down, then two
@@ -256,7 +269,7 @@ class Controller(ControllerCore):
             if ex > 0:
                 return self._emit(dp.turn_right(speed_for(dp.CommandName.TURN_RIGHT, frac)))
             return self._emit(dp.turn_left(speed_for(dp.CommandName.TURN_LEFT, frac)))
-        if abs(ey) > cfg.dead_band_y:
+        if abs(ey) > cfg.dead_band_y and not self.seen_from.barred(ey < 0, self.height.settles_m, ey):
             frac = 0.5 + 0.5 * min(1.0, abs(ey) / 0.6)
             if ey < 0:
                 return self._emit(dp.move_up(speed_for(dp.CommandName.MOVE_UP, frac)))

@@ -1,0 +1,47 @@
+"""What the firmware's sticks hold after each frame the pilot sends, for the pilot's dead reckoning (its lean,
+its forward speed, its height): a pitch or throttle command holds its stick for the firmware's command timeout,
+any other movement or a hold releases it, and a non-movement frame (servo, laser, status) changes nothing."""
+
+from __future__ import annotations
+
+import drone_protocol as dp
+
+STICK_CHANNELS = frozenset(c.value for c in dp.ChannelName)  # commands that move a stick
+
+
+def _steps(command: dp.Command, channel: dp.ChannelName) -> float:
+    """A stick command's deflection from its channel's median, in speed steps."""
+    median = dp.CHANNELS[channel].median
+    return abs(int(command.value or median) - median) / dp.SPEED_STEP_US
+
+
+class HeldSticks:
+    def __init__(self) -> None:
+        self._pitch = 0.0  # speed steps, forward positive
+        self._throttle = 0.0  # speed steps, up positive
+        self._until_ms = 0
+
+    def pitch(self, now_ms: int) -> float:
+        return self._pitch if now_ms <= self._until_ms else 0.0
+
+    def throttle(self, now_ms: int) -> float:
+        return self._throttle if now_ms <= self._until_ms else 0.0
+
+    def sent(self, frame: bytes | None, now_ms: int) -> None:
+        if frame is None:
+            return
+        try:
+            command = dp.decode(frame)
+        except dp.ProtocolError:
+            return
+        channel = dp.COMMANDS[command.name].target
+        if channel not in STICK_CHANNELS and command.name is not dp.CommandName.HOLD_ALTITUDE:
+            return
+        self._pitch = self._throttle = 0.0
+        self._until_ms = now_ms + dp.COMMAND_TIMEOUT_MS
+        if channel == dp.ChannelName.PITCH.value:
+            sense = 1 if command.name is dp.CommandName.MOVE_FORWARD else -1
+            self._pitch = sense * _steps(command, dp.ChannelName.PITCH)
+        elif channel == dp.ChannelName.THROTTLE.value:
+            sense = 1 if command.name is dp.CommandName.MOVE_UP else -1
+            self._throttle = sense * _steps(command, dp.ChannelName.THROTTLE)
