@@ -75,6 +75,9 @@ class Controller(ControllerCore):
         super().__init__(config, clock)
         self.gate = Gate(self.cfg)  # vision gate (issue 12): every sighting and every laser-on goes through it
         self.closing = ClosingSpeed()
+        # the same over 1.2 s, for the speed at a loss: a target going out of sight (covered, clipped by the
+        # frame's edge) shrinks in its last frames, and the short fit then reads a closing speed near zero
+        self.closing_trend = ClosingSpeed(window_s=1.2, min_samples=8)
         self.momentum = Momentum(self.cfg.pitch_accel_mps2)
         self.lean = Lean(self.cfg.pitch_accel_mps2)
         self.height = Height(self.cfg.climb_mps_per_step)
@@ -124,9 +127,11 @@ class Controller(ControllerCore):
         self._last_ms = now
         if det is not None and det.found and self.state in LOCKED:
             self.closing.update(now / 1000.0, det.range_m)
+            self.closing_trend.update(now / 1000.0, det.range_m)
             self.momentum.observe(self.closing.closing)
         elif self.state not in LOCKED and self.state is not State.SEARCH:
             self.closing.reset()
+            self.closing_trend.reset()
             self.momentum.reset()
         frame = self._decide_frame(det)
         if det is not None and self.gate.acquired() and not det.predicted:
@@ -217,7 +222,8 @@ class Controller(ControllerCore):
         """Target lost: laser off first, then sticks neutral, then the servos home, then search; lost while
         closing in, the search starts by braking for as long as the last closing speed needs."""
         off = self._laser(False)
-        closing = self.momentum.speed  # vision's last estimate, carried on by dead reckoning
+        # vision's last estimate carried on by dead reckoning, or the longer trend if that is faster
+        closing = max(self.momentum.speed, self.closing_trend.closing or 0.0)
         if closing > 0.15:
             self._brake_until_ms = self._now() + round(1000.0 * closing / self.cfg.brake_mps2)
             self._brake_speed = closing

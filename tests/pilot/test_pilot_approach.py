@@ -78,6 +78,25 @@ def test_lost_while_closing_brakes_before_the_search_turns() -> None:
     assert dp.COMMANDS[dp.CommandName.MOVE_BACKWARD].target == "pitch"
 
 
+def test_a_target_that_stops_shrinking_before_it_is_lost_still_gets_its_brake() -> None:
+    """Going out of sight, a target's last frames can read a constant range (covered or clipped, it looks
+    smaller than it is): the brake at the loss follows the last 1.2 s of ranges, not only the last 0.4 s."""
+    c, rig = to_state(State.TRACK)
+    r = 3.0
+    for _ in range(16):
+        r -= 0.03  # 0.6 m/s closer for 0.8 s ...
+        rig.tick(seen(size=size_at(r)))
+    for _ in range(9):
+        rig.tick(seen(size=size_at(r)))  # ... then 0.45 s of one range
+    assert c.closing.closing is not None and c.closing.closing < 0.15
+    while st(c) is not State.SEARCH:
+        rig.tick(MISS)
+    brakes = 0
+    while name(rig.tick(MISS)) == "move_backward":
+        brakes += 1
+    assert brakes * 50 >= 600  # the trend: about 0.4 m/s at 0.5 m/s² (dead reckoning alone: 0.15 m/s, 0.3 s)
+
+
 def test_the_lean_follows_the_pitch_stick_with_a_lag() -> None:
     lean = Lean(CFG.pitch_accel_mps2)
     assert lean.deg_per_step == pytest.approx(math.degrees(math.atan(CFG.pitch_accel_mps2 / 9.81)))
