@@ -29,11 +29,14 @@ States (``State``)::
   above (below): a ceiling (floor) just inside the height it was seen from bars the height correction while the
   target stays near the frame's middle, and the approach goes on off-centre (``pilot.vertical``).
   AIM begins there and returns to TRACK only below ``retreat_size`` (hysteresis); above ``back_off_size`` it
-  backs off before it fires. Up to ``coast_frames`` missed frames during a forward approach keep it going (a
+  backs off before it fires. Back in TRACK with the camera panned, the body turns to the target before the
+  servos reset (a reset would otherwise swing it out of the frame). A target that stands still in the frame through
+  ``response.NO_RESPONSE_MS`` of hard turning means a drone that does not answer its sticks (crashed, caught): LAND.
+  Up to ``coast_frames`` missed frames during a forward approach keep it going (a
   far target flickers in and out of detection).
 * AIM holds position and centres the target with the pan/tilt servos (only from measured sightings: a
   tracker's prediction knows nothing of the step just sent); after ``aim_frames`` centred
-  frames FIRE switches the laser on. The laser stays on only while the target is found and centred;
+  frames FIRE switches the laser on. The laser stays on only while the target is found, centred and in range;
   after ``fire_ms`` lit (as the drone confirmed it) it is switched off and the drone lands. While
   firing, small errors (within twice the aim tolerance) are still corrected
   with the servos; larger ones switch the laser off and go back to AIM.
@@ -58,6 +61,7 @@ from .config import ControllerConfig
 from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, speed_for
 from .detection import Detection
 from .gating import Gate
+from .response import TurnResponse, turn_sense
 from .sticks import HeldSticks
 from .vertical import Height, SeenFrom
 
@@ -84,6 +88,8 @@ class Controller(ControllerCore):
         self.seen_from = SeenFrom()
         self._return_m: float | None = None  # a search first goes back to this height
         self.sticks = HeldSticks()
+        self.response = TurnResponse()
+        self._turned = 0  # the last frame's hard turn (+1 right, -1 left), whose effect this frame shows
         self._last_ms = self._now()
         self._brake_until_ms = 0  # target lost while closing in: brake this long before searching
         self._brake_speed = 0.0
@@ -105,9 +111,6 @@ class Controller(ControllerCore):
         if det is not None and det.found:
             frac = max(MIN_BRAKE, min(frac, self._brake_room(det)))
         return self._emit(dp.move_backward(speed_for(dp.CommandName.MOVE_BACKWARD, frac)))
-
-    def _tan_v(self, det: Detection) -> float:
-        return self._tan_h * (det.height / det.width) if det.width else self._tan_h
 
     def _brake_room(self, det: Detection) -> float:
         """The backward lean, in speed steps, that keeps the target's lower edge within ``VIEW_EDGE`` of the
@@ -133,10 +136,17 @@ class Controller(ControllerCore):
             self.closing.reset()
             self.closing_trend.reset()
             self.momentum.reset()
+        cx = det.cx if det is not None and det.found and not det.predicted else None
+        if self.state is not State.TRACK:
+            self.response.reset()
+        elif self.response.observe(now, self._turned, cx, det.width if det is not None else 0):
+            self._go(State.LAND, "the drone does not answer the yaw stick (the target stood still through a hard "
+                                 "turn): crashed or caught on something")
         frame = self._decide_frame(det)
         if det is not None and self.gate.acquired() and not det.predicted:
             self.seen_from.saw(self.height.m)
         self.sticks.sent(frame, self._now())
+        self._turned = turn_sense(frame)
         return frame
 
     def _decide_frame(self, det: Detection | None) -> bytes | None:
@@ -256,6 +266,9 @@ class Controller(ControllerCore):
         self._coast = None
         cfg = self.cfg
         if self._pan_offset or self._tilt_offset:
+            turn = self._turn_to_camera(det)  # the body first, where a reset would lose the target
+            if turn is not None:
+                return self._emit(turn)
             self._pan_offset = self._tilt_offset = 0
             return self._emit(dp.servo_reset())
         ex, ey, size = det.error_x, det.error_y, det.relative_size
@@ -285,32 +298,6 @@ class Controller(ControllerCore):
         frac = 1.8 if size < 0.45 * cfg.approach_size else (1.0 if size < 0.75 * cfg.approach_size else 0.6)
         self._coast = self._emit(dp.move_forward(speed_for(dp.CommandName.MOVE_FORWARD, frac)))
         return self._coast
-
-    def _remember_side(self, det: Detection) -> None:
-        """Which way to sweep if the target is lost: its bearing from the body (camera pan included)."""
-        bearing = self._pan_offset + math.degrees(math.atan(det.error_x * self._tan_h))
-        self._search_sign = 1 if bearing >= 0 else -1
-
-    def _servo_correction(self, det: Detection) -> bytes | None:
-        """One pan or tilt step towards the target, the larger error first; None when centred."""
-        ex, ey = det.error_x, det.error_y
-        tol = self.cfg.aim_tolerance
-        tan_v = self._tan_v(det)
-        if abs(ex) <= tol and abs(ey) <= tol:
-            return None
-        if abs(ex) >= abs(ey):
-            deg = max(1, round(math.degrees(math.atan(abs(ex) * self._tan_h))))
-            if ex > 0:
-                self._pan_offset += deg
-                return self._emit(dp.servo_right(deg))
-            self._pan_offset -= deg
-            return self._emit(dp.servo_left(deg))
-        deg = max(1, round(math.degrees(math.atan(abs(ey) * tan_v))))
-        if ey < 0:
-            self._tilt_offset += deg
-            return self._emit(dp.servo_up(deg))
-        self._tilt_offset -= deg
-        return self._emit(dp.servo_down(deg))
 
     def _on_aim(self, det: Detection | None) -> bytes | None:
         if self._lost(det, self.cfg.lost_frames):
@@ -368,9 +355,10 @@ class Controller(ControllerCore):
         self._misses = 0
         self._remember_side(det)
         loose = 2.0 * self.cfg.aim_tolerance
-        if abs(det.error_x) > loose or abs(det.error_y) > loose:
+        far = det.relative_size < self.cfg.retreat_size  # drifted back out of range (AIM approaches again)
+        if far or abs(det.error_x) > loose or abs(det.error_y) > loose:
             off = self._laser(False)
-            self._go(State.AIM, "off centre while firing")
+            self._go(State.AIM, "out of range while firing" if far else "off centre while firing")
             return off if off is not None else self._on_aim(det)
         if not self.gate.confirmed():  # vision gate: found, but not confirmed in enough frames in a row
             off = self._laser(False)

@@ -35,6 +35,7 @@ class State(enum.Enum):
 
 FLYING = frozenset({State.TAKEOFF, State.HOLD, State.SEARCH, State.ACQUIRE, State.TRACK, State.AIM, State.FIRE})
 LOCKED = frozenset({State.ACQUIRE, State.TRACK, State.AIM, State.FIRE})
+RESET_ERROR = 0.4  # a servo reset in TRACK may leave the target this far off the middle (of the half-width)
 
 
 @dataclass(frozen=True)
@@ -209,6 +210,49 @@ class ControllerCore:
         handler = getattr(self, f"_on_{self.state.value}")
         result: bytes | None = handler(det)
         return result
+
+    # -- the camera's geometry: bearings, servo steps ------------------------------------------------
+    def _tan_v(self, det: Detection) -> float:
+        return self._tan_h * (det.height / det.width) if det.width else self._tan_h
+
+    def _remember_side(self, det: Detection) -> None:
+        """Which way to sweep if the target is lost: its bearing from the body (camera pan included)."""
+        bearing = self._pan_offset + math.degrees(math.atan(det.error_x * self._tan_h))
+        self._search_sign = 1 if bearing >= 0 else -1
+
+    def _servo_correction(self, det: Detection) -> bytes | None:
+        """One pan or tilt step towards the target, the larger error first; None when centred."""
+        ex, ey = det.error_x, det.error_y
+        tol = self.cfg.aim_tolerance
+        tan_v = self._tan_v(det)
+        if abs(ex) <= tol and abs(ey) <= tol:
+            return None
+        if abs(ex) >= abs(ey):
+            deg = max(1, round(math.degrees(math.atan(abs(ex) * self._tan_h))))
+            if ex > 0:
+                self._pan_offset += deg
+                return self._emit(dp.servo_right(deg))
+            self._pan_offset -= deg
+            return self._emit(dp.servo_left(deg))
+        deg = max(1, round(math.degrees(math.atan(abs(ey) * tan_v))))
+        if ey < 0:
+            self._tilt_offset += deg
+            return self._emit(dp.servo_up(deg))
+        self._tilt_offset -= deg
+        return self._emit(dp.servo_down(deg))
+
+    def _turn_to_camera(self, det: Detection) -> bytes | None:
+        """With the camera panned, the turn that brings the body round to the target until a servo reset would
+        leave it within ``RESET_ERROR`` of the frame's middle (None: reset now)."""
+        bearing = self._pan_offset + math.degrees(math.atan(det.error_x * self._tan_h))  # from the body's axis
+        bearing = max(-80.0, min(80.0, bearing))  # (the servo's own limit is nearer; past 90° tan turns round)
+        after = math.tan(math.radians(bearing)) / self._tan_h  # the horizontal error a reset would leave
+        if abs(after) <= RESET_ERROR:
+            return None
+        frac = 0.35 + 0.65 * min(1.0, abs(after) / 0.5)
+        if after > 0:
+            return dp.turn_right(speed_for(dp.CommandName.TURN_RIGHT, frac))
+        return dp.turn_left(speed_for(dp.CommandName.TURN_LEFT, frac))
 
     def _on_idle(self, det: Detection | None) -> bytes | None:
         return None

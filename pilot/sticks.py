@@ -9,7 +9,7 @@ import drone_protocol as dp
 STICK_CHANNELS = frozenset(c.value for c in dp.ChannelName)  # commands that move a stick
 
 
-def _steps(command: dp.Command, channel: dp.ChannelName) -> float:
+def deflection_steps(command: dp.Command, channel: dp.ChannelName) -> float:
     """A stick command's deflection from its channel's median, in speed steps."""
     median = dp.CHANNELS[channel].median
     return abs(int(command.value or median) - median) / dp.SPEED_STEP_US
@@ -41,7 +41,7 @@ class HeldSticks:
         self._until_ms = now_ms + dp.COMMAND_TIMEOUT_MS
         if channel == dp.ChannelName.PITCH.value:
             sense = 1 if command.name is dp.CommandName.MOVE_FORWARD else -1
-            self._pitch = sense * _steps(command, dp.ChannelName.PITCH)
+            self._pitch = sense * deflection_steps(command, dp.ChannelName.PITCH)
         elif channel == dp.ChannelName.THROTTLE.value:
             sense = 1 if command.name is dp.CommandName.MOVE_UP else -1
-            self._throttle = sense * _steps(command, dp.ChannelName.THROTTLE)
+            self._throttle = sense * deflection_steps(command, dp.ChannelName.THROTTLE)
