@@ -16,8 +16,10 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
    bench/vision); measuring stops as soon as the product so far is below ``hsv.min_score``:
 
    * shape: the share of the contour lying on its minimum enclosing circle ("arc support": a disk ~1, a
-     disk with 30 % hidden behind an edge ~0.7, a square ~0.3), solidity, fill of that circle, and the
-     aspect of its minimum-area rectangle (a rotated bar has a square bounding box).
+     disk with 30 % hidden behind an edge ~0.7, a square ~0.3) or, where that is low, on an ellipse fitted
+     robustly to it (a ball seen through a perspective warp, or with a stub of background attached; its ramp
+     is stricter, as an ellipse fits a square's sides better than the enclosing circle does), solidity, fill of
+     that circle, and the aspect of its minimum-area rectangle (a rotated bar has a square bounding box).
    * colour purity: mean saturation, and how far the mean hue sits from the middle of the range (orange
      and red-brown sit near its edge, the target's red in the middle).
    * isolation: the share of the ring around the circle (1.25 to 1.75 radii, sampled) that is of the
@@ -28,6 +30,16 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
 
    The circle, not the blob's centroid, gives the position: a ball's dark side or a covered part moves
    a centroid, not the circle through its rim.
+3. Split: a ball in front of something of its colour (a red motorbike, a red-brown saucer) joins it in the
+   mask, and the joined blob is no disc. Unless a candidate already scores ``SPLIT_UNLESS``, the largest search
+   blobs filling less than ``SPLIT_FILL`` of their box's disc are searched for the widest discs inside them
+   (maxima of the distance transform); around each, at full resolution, the mask is opened by a disc
+   ``SPLIT_OPEN`` as wide, which cuts necks and keeps the ball whole, and the piece holding the centre is
+   measured as above, its arcs counting only where its outline is the mask's real edge, not a cut (an opened
+   square is round).
+
+A blob at least ``HALF_MEASURE`` px across is measured on the search itself (half resolution shows its shape
+well enough), which saves the refinement's fixed cost.
 """
 
 from __future__ import annotations
@@ -43,16 +55,26 @@ from cv2.typing import MatLike
 from .config import HsvConfig, VisionConfig
 from .detection import Candidate, Detection, best_detection, frame_size, range_of
 from .errors import ConfigError
+from .hsv_shape import RING_POINTS, disc_centres, ellipse_support, open_by_disc, outer_rim, share_set
 
 MAX_CANDIDATES = 4  # the largest search blobs refined; smaller ones cannot be the nearest target
 SEARCH_FILL = 0.45  # below FILL's zero: the search's coarser outline never rejects what the refinement keeps
 BLOBS_PER_BOX = 2  # blobs measured in one search blob's window (noise can join two at half resolution)
 SEARCH_MIN_WIDTH = 320  # frames at least this wide are searched at half resolution
+HALF_MEASURE = 48  # px across (full resolution): a search blob this wide is measured at half resolution
 V_REFERENCE = 200.0  # brightness (see _exposure) of a well-exposed frame; the V bound scales below it
 V_FLOOR = 24  # the V bound never drops below this: under it hue and saturation are noise
+SPLIT_FILL = 0.75  # a search blob filling less of its box's disc may be a ball joined to something
+SPLIT_BLOBS = 3  # the largest such blobs searched for discs
+SPLIT_PEAKS = 4  # disc centres refined per frame, widest first
+SPLIT_OPEN = 0.5  # the opening's disc, in radii of the disc found (0.6 let opened squares through: red_shape)
+SPLIT_CUT = 0.1  # the opening must cut off this much (of the piece's area): else the blob was joined to nothing
+SPLIT_UNLESS = 0.8  # a candidate scoring this already: no split (it costs ~0.3 ms a window)
+RIM_STEP = 2.0  # px outwards from a contour point where the unopened mask must be unset for a real edge
 # score ramps (zero, one), set on the tuning photos only (bench/vision/RESULTS.md)
 ARC = (0.3, 0.6)
 ARC_TOL = 0.12  # a contour point within this share of the radius (at least 1.5 px) lies on the circle
+ELLIPSE_ARC = (0.7, 0.9)  # the share on the fitted ellipse (pilot/hsv_shape.py): squares reach 0.5-0.8
 SOLIDITY = (0.7, 0.88)
 FILL = (0.35, 0.6)
 ELONGATION = (2.0, 1.4)  # minimum-area rectangle, longer side over shorter (falling ramp)
@@ -63,24 +85,7 @@ SIZE = (8.0, 16.0)  # diameter, pixels: a smaller blob has too few pixels to sho
 
 
 Bounds = list[tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]]  # inRange's lower and upper HSV triples
-# the ring from 1.25 to 1.75 radii, in radii: three circles of 48 points (sampling it costs a third of drawing it)
-_ANGLES = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
-_RING_POINTS = np.concatenate([k * np.stack([np.cos(_ANGLES), np.sin(_ANGLES)], axis=1) for k in (1.33, 1.5, 1.67)])
-
-
-def _share_set(mask: MatLike, cx: float, cy: float, unit: npt.NDArray[np.float64], r: float) -> float:
-    """The share of the points ``unit * r`` (offsets from cx, cy; at most 1.7 r away) inside the mask's frame that
-    are set in it."""
-    h, w = mask.shape[:2]
-    pos = unit * r + (cx + 0.5, cy + 0.5)  # + 0.5: truncation rounds
-    reach = 1.7 * r + 1.0
-    if reach <= cx < w - reach and reach <= cy < h - reach:  # all inside: the usual case
-        idx = pos.astype(np.intp)
-    else:
-        idx = pos[(pos[:, 0] >= 0.0) & (pos[:, 0] < w) & (pos[:, 1] >= 0.0) & (pos[:, 1] < h)].astype(np.intp)
-        if not len(idx):
-            return 1.0
-    return float(np.count_nonzero(np.asarray(mask)[idx[:, 1], idx[:, 0]])) / len(idx)
+Box = tuple[int, int, int, int]  # x, y, width, height
 
 
 class Features(NamedTuple):
@@ -96,10 +101,15 @@ class Features(NamedTuple):
     saturation: float  # mean, 0..255
     hue_off: float  # mean hue's distance from the range's middle, in half-widths
     ring: float
+    ellipse_arc: float  # 0 where the circle's arc was enough (it is measured only below ARC's one)
 
 
 def _ramp(value: float, zero: float, one: float) -> float:
     return min(1.0, max(0.0, (value - zero) / (one - zero)))
+
+
+def _arc_score(arc: float, ellipse_arc: float) -> float:
+    return max(_ramp(arc, *ARC), _ramp(ellipse_arc, *ELLIPSE_ARC))
 
 
 def _contiguous(hues: set[int]) -> tuple[int, int] | None:
@@ -192,48 +202,112 @@ class HsvBlobDetector:
         bounds = self._bounds(self._exposure(image))
         scale = 2 if w >= SEARCH_MIN_WIDTH else 1
         small = cv2.resize(image, (w // scale, h // scale), interpolation=cv2.INTER_AREA) if scale > 1 else image
-        mask = self._raw_mask(small, bounds)
+        small_hsv = cv2.cvtColor(small, self._code)
+        mask = self._in_range(small_hsv, bounds)
         if self._kernel is not None:
             mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, self._kernel)
-        contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+        # every point kept: a blob measured on the search needs them for its arcs
+        contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
         min_area = self.cfg.min_area / (scale * scale)
-        boxes = []
+        boxes: list[tuple[float, MatLike, Box]] = []
+        joined: list[tuple[float, MatLike, Box]] = []
         for c in contours:
-            if len(c) < 3 or (area := cv2.contourArea(c)) < min_area:
+            if len(c) < 6 or (area := cv2.contourArea(c)) < min_area:
                 continue
             x, y, bw, bh = cv2.boundingRect(c)
+            box = (x, y, bw, bh)
+            disc = math.pi * (max(bw, bh) / 2.0) ** 2
             # a blob filling less than SEARCH_FILL of its box's disc cannot hold a ball the refinement would take
-            if area >= SEARCH_FILL * math.pi * (max(bw, bh) / 2.0) ** 2:
-                boxes.append((area, (x * scale, y * scale, bw * scale, bh * scale)))
+            if area >= SEARCH_FILL * disc:
+                boxes.append((area, c, box))
+            if area < SPLIT_FILL * disc:
+                joined.append((area, c, box))
         boxes.sort(key=lambda b: b[0], reverse=True)
         found: list[Features] = []
-        for _, box in boxes[:MAX_CANDIDATES]:
-            for f in self._refine(image, bounds, box):
-                if all(abs(f.cx - g.cx) > 1.0 or abs(f.cy - g.cy) > 1.0 for g in found):
-                    found.append(f)
+        for area, c, (x, y, bw, bh) in boxes[:MAX_CANDIDATES]:
+            if scale > 1 and max(bw, bh) * scale >= HALF_MEASURE:
+                f = self._measure(small_hsv, mask, c, area, 0, 0, scale=scale)
+                fs = [] if f is None else [f]
+            else:
+                fs = self._refine(image, bounds, (x * scale, y * scale, bw * scale, bh * scale))
+            found += [f for f in fs if all(abs(f.cx - g.cx) > 1.0 or abs(f.cy - g.cy) > 1.0 for g in found)]
+        if joined and not any(self.score(f, w) >= SPLIT_UNLESS for f in found):
+            found += self._split(image, bounds, mask, joined, scale, found)
         return found
 
-    def _refine(self, image: MatLike, bounds: Bounds, box: tuple[int, int, int, int]) -> list[Features]:
+    def _split(self, image: MatLike, bounds: Bounds, mask: MatLike, joined: list[tuple[float, MatLike, Box]],
+               scale: int, found: list[Features]) -> list[Features]:
+        """Balls joined to something of their colour: the widest discs of the largest joined blobs, refined."""
+        joined.sort(key=lambda b: b[0], reverse=True)
+        centres = [p for _, c, box in joined[:SPLIT_BLOBS] for p in disc_centres(mask, c, box)]
+        centres.sort(reverse=True)
+        out: list[Features] = []
+        for r, px, py in centres[:SPLIT_PEAKS]:
+            half = (scale - 1) / 2.0
+            f = self._refine_disc(image, bounds, px * scale + half, py * scale + half, r * scale)
+            if f is not None and all(abs(f.cx - g.cx) > 1.0 or abs(f.cy - g.cy) > 1.0 for g in found + out):
+                out.append(f)
+        return out
+
+    def _window(self, image: MatLike, bounds: Bounds, x0: int, y0: int, x1: int, y1: int) -> tuple[MatLike, MatLike]:
+        """The window's HSV and cleaned mask."""
+        # smoothed: sensor noise in a ball's shaded side would fray its outline and the shape with it
+        roi = cv2.medianBlur(np.ascontiguousarray(image[y0:y1, x0:x1]), 3)
+        hsv = cv2.cvtColor(roi, self._code)
+        return hsv, self._clean(self._in_range(hsv, bounds))
+
+    def _refine(self, image: MatLike, bounds: Bounds, box: Box) -> list[Features]:
         """The blobs of a search box at full resolution (a search blob may be several joined by noise), in a
         window that also holds their rings."""
         w, h = frame_size(image)
         bx, by, bw, bh = box
         pad = max(bw, bh) // 2 + 4  # a ring reaches 1.75 radii; the search rounds by a pixel or two
-        x0, y0, x1, y1 = max(0, bx - pad), max(0, by - pad), min(w, bx + bw + pad), min(h, by + bh + pad)
-        # smoothed: sensor noise in a ball's shaded side would fray its outline and the shape with it
-        roi = cv2.medianBlur(np.ascontiguousarray(image[y0:y1, x0:x1]), 3)
-        hsv = cv2.cvtColor(roi, self._code)
-        mask = self._clean(self._in_range(hsv, bounds))
+        x0, y0 = max(0, bx - pad), max(0, by - pad)
+        hsv, mask = self._window(image, bounds, x0, y0, min(w, bx + bw + pad), min(h, by + bh + pad))
         contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
         blobs = [(a, c) for c in contours if len(c) >= 8 and (a := float(cv2.contourArea(c))) >= self.cfg.min_area]
         blobs.sort(key=lambda b: b[0], reverse=True)
         found = (self._measure(hsv, mask, c, area, x0, y0) for area, c in blobs[:BLOBS_PER_BOX])
         return [f for f in found if f is not None]
 
-    def _measure(self, hsv: MatLike, mask: MatLike, c: MatLike, area: float, x0: int, y0: int) -> Features | None:
-        """The blob's features; None as soon as the product of its factors so far is below ``min_score``."""
+    def _refine_disc(self, image: MatLike, bounds: Bounds, px: float, py: float, r: float) -> Features | None:
+        """The piece of the mask around a disc centre that an opening by a disc SPLIT_OPEN as wide leaves."""
+        w, h = frame_size(image)
+        pad = int(2.0 * r) + 6  # the ring reaches 1.75 radii
+        cx, cy = int(px), int(py)
+        x0, y0 = max(0, cx - pad), max(0, cy - pad)
+        hsv, mask = self._window(image, bounds, x0, y0, min(w, cx + pad + 1), min(h, cy + pad + 1))
+        dist = cv2.distanceTransform(mask, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+        opened = open_by_disc(mask, SPLIT_OPEN * (r + 1.0), dist)
+        # the widest disc near the search's centre: the ball, where the opening may leave shoulders of what
+        # it is joined to (a neck wider than the opening's disc), which would pull an enclosing circle
+        k = max(2, int(r / 3.0))
+        near = dist[max(0, cy - y0 - k) : cy - y0 + k + 1, max(0, cx - x0 - k) : cx - x0 + k + 1]
+        _, r_in, _, (mx, my) = cv2.minMaxLoc(near)
+        centre = (float(mx + max(0, cx - x0 - k)), float(my + max(0, cy - y0 - k)))  # in the window
+        contours, _ = cv2.findContours(opened, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+        for c in contours:
+            if cv2.pointPolygonTest(c, centre, False) >= 0:
+                area = float(cv2.contourArea(c))
+                # joined to nothing (the opening only rounded its corners: a square), or too small
+                cut_off = cv2.countNonZero(mask) - cv2.countNonZero(opened)
+                if len(c) < 8 or area < self.cfg.min_area or cut_off < SPLIT_CUT * area:
+                    return None
+                # the ring on the unopened mask: what the opening cut off is still around the ball
+                f = self._measure(hsv, mask, c, area, x0, y0, cut=True)
+                # a drawn disc 2 R + 1 px across reads R at its centre (precise mask)
+                return None if f is None else f._replace(cx=centre[0] + x0, cy=centre[1] + y0, size=2.0 * r_in + 1.0)
+        return None
+
+    def _measure(self, hsv: MatLike, mask: MatLike, c: MatLike, area: float, x0: int, y0: int,
+                 scale: int = 1, cut: bool = False) -> Features | None:
+        """The blob's features; None as soon as the product of its factors so far is below ``min_score``.
+        ``scale``: the mask is the search's, that many times smaller than the frame; ``cut``: the blob is a piece
+        an opening left, and only its outline on the mask's real edge counts for its arcs."""
         (cx, cy), r = cv2.minEnclosingCircle(c)
-        size = 2.0 * r + 1.0  # the circle passes through pixel centres; the ball covers the pixels
+        # the circle passes through pixel centres; the ball covers the pixels. At half resolution a pixel a
+        # third covered by the ball already passes the mask: its circle runs ~0.4 px outside (4 r - 1, not + 2)
+        size = 2.0 * r * scale + 1.0 - 2.0 * (scale - 1)
         (_, _), (rw, rh), _ = cv2.minAreaRect(c)
         elongation = max(rw, rh) / max(1e-6, min(rw, rh))
         fill = area / (math.pi * r * r) if r > 0 else 0.0
@@ -242,7 +316,7 @@ class HsvBlobDetector:
         if geometry <= 0.0 or geometry < self.cfg.min_score:
             return None
         # the ring from 1.25 to 1.75 radii, sampled: outside the blob's circle, so the mask there is something else
-        ring = _share_set(mask, cx, cy, _RING_POINTS, max(r, 2.0))
+        ring = share_set(mask, cx, cy, RING_POINTS, max(r, 2.0))
         geometry *= _ramp(ring, *RING)
         if geometry <= 0.0 or geometry < self.cfg.min_score:
             return None
@@ -250,19 +324,24 @@ class HsvBlobDetector:
         d2 = np.square(pts - (cx, cy)).sum(axis=1)
         tol = max(1.5, ARC_TOL * r)
         on_arc = (d2 >= (r - tol) ** 2) & (d2 <= (r + tol) ** 2)
+        real = outer_rim(mask, pts, cx, cy, RIM_STEP) if cut else None
+        if real is not None:
+            on_arc &= real
         arc = float(np.count_nonzero(on_arc)) / len(pts)
+        ellipse_arc = ellipse_support(pts, real) if arc < ARC[1] else 0.0
         hull = float(cv2.contourArea(cv2.convexHull(c)))
         solidity = area / hull if hull > 0 else 0.0
-        geometry *= _ramp(arc, *ARC) * _ramp(solidity, *SOLIDITY)
+        geometry *= _arc_score(arc, ellipse_arc) * _ramp(solidity, *SOLIDITY)
         if geometry <= 0.0 or geometry < self.cfg.min_score:
             return None
         # colour: the mean over the blob's box (the mask's pixels there are the blob's, or nearly)
         bx, by, bw, bh = cv2.boundingRect(c)
         box = (slice(by, by + bh), slice(bx, bx + bw))
         mean = cv2.mean(hsv[box], mask=mask[box])
+        half = (scale - 1) / 2.0  # a pixel's centre at half resolution lies between two at full resolution
         return Features(
-            cx + x0, cy + y0, size, arc, solidity, fill, elongation, float(mean[1]),
-            abs(float(mean[0]) - self._hue_mid) / self._hue_half, ring,
+            (cx + x0) * scale + half, (cy + y0) * scale + half, size, arc, solidity, fill, elongation,
+            float(mean[1]), abs(float(mean[0]) - self._hue_mid) / self._hue_half, ring, ellipse_arc,
         )
 
     def _size_score(self, size: float, width: int) -> float:
@@ -272,7 +351,7 @@ class HsvBlobDetector:
         return _ramp(size, *SIZE)
 
     def score(self, f: Features, width: int) -> float:
-        shape = _ramp(f.arc, *ARC) * _ramp(f.solidity, *SOLIDITY) * _ramp(f.fill, *FILL)
+        shape = _arc_score(f.arc, f.ellipse_arc) * _ramp(f.solidity, *SOLIDITY) * _ramp(f.fill, *FILL)
         shape *= _ramp(f.elongation, *ELONGATION) * self._size_score(f.size, width)
         colour = _ramp(f.saturation, self._sat_lo + SATURATION[0], self._sat_lo + SATURATION[1])
         colour *= 1.0 - _ramp(f.hue_off, *HUE_OFF)

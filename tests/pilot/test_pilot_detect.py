@@ -63,6 +63,43 @@ def test_hsv_no_detection_with_only_distractors(width: int, height: int, gain: f
     assert not d.found, d
 
 
+@pytest.mark.parametrize("width,height", SIZES)
+def test_hsv_ball_joined_to_something_red_is_split_off(width: int, height: int) -> None:
+    """A ball overlapping a red bar (a red motorbike's frame behind it) is no disc in the mask; the split (the
+    widest disc in the joined blob, the mask opened around it) gives it back, centred; the bar alone is no ball.
+    The smaller ball's neck is wider for its size: shoulders of the bar stay on it and score it down."""
+    s = width // 320
+    bar = synth.background(width, height)
+    cv2.rectangle(bar, (40 * s, 100 * s), (280 * s, 108 * s), synth.RED, -1)
+    assert not HsvBlobDetector(HsvConfig()).detect(bar).found
+    for cx, cy, r, least in ((160, 128, 22, 0.6), (90, 88, 14, 0.3)):  # below the bar; above it, at its left
+        img = synth.red_disc(bar, cx * s, cy * s, r * s)
+        d = HsvBlobDetector(HsvConfig()).detect(img)
+        assert d.found and d.confidence >= least, (cx, cy, d)
+        assert abs(d.cx - cx * s) <= 1.5 * s and abs(d.cy - cy * s) <= 1.5 * s, (cx, cy, d)
+        assert abs(d.size - 2 * r * s) <= 3.0 * s, (cx, cy, d)
+
+
+@pytest.mark.parametrize("axes", [(20, 16), (30, 23), (12, 10)])
+def test_hsv_ball_seen_at_an_angle_is_acquired(axes: tuple[int, int]) -> None:
+    """A ball through a perspective warp is an ellipse: its enclosing circle misses most of its outline, a fitted
+    ellipse does not."""
+    img = synth.background(320, 240)
+    cv2.ellipse(img, (150, 110), axes, 30.0, 0.0, 360.0, synth.RED, -1, cv2.LINE_AA)
+    d = HsvBlobDetector(HsvConfig()).detect(img)
+    assert d.found and d.confidence >= 0.6, d
+    assert abs(d.cx - 150) <= 1.5 and abs(d.cy - 110) <= 1.5, d
+
+
+@pytest.mark.parametrize("angle", [0.0, 20.0, 45.0])
+def test_hsv_red_square_is_no_ball(angle: float) -> None:
+    img = synth.background(320, 240)
+    box = cv2.boxPoints(((160.0, 120.0), (30.0, 30.0), angle))
+    cv2.fillPoly(img, [np.round(box).astype(np.int32)], synth.RED, cv2.LINE_AA)
+    d = HsvBlobDetector(HsvConfig()).detect(img)
+    assert not d.found or d.confidence < 0.6, d
+
+
 @pytest.mark.parametrize(
     "hue,sat,lo,hi",
     [
