@@ -232,14 +232,14 @@ class HsvBlobDetector:
                 fs = self._refine(image, bounds, (x * scale, y * scale, bw * scale, bh * scale))
             found += [f for f in fs if all(abs(f.cx - g.cx) > 1.0 or abs(f.cy - g.cy) > 1.0 for g in found)]
         if joined and not any(self.score(f, w) >= SPLIT_UNLESS for f in found):
-            found += self._split(image, bounds, mask, joined, scale, found)
+            found += self._split(image, bounds, joined, scale, found)
         return found
 
-    def _split(self, image: MatLike, bounds: Bounds, mask: MatLike, joined: list[tuple[float, MatLike, Box]],
+    def _split(self, image: MatLike, bounds: Bounds, joined: list[tuple[float, MatLike, Box]],
                scale: int, found: list[Features]) -> list[Features]:
         """Balls joined to something of their colour: the widest discs of the largest joined blobs, refined."""
         joined.sort(key=lambda b: b[0], reverse=True)
-        centres = [p for _, c, box in joined[:SPLIT_BLOBS] for p in disc_centres(mask, c, box)]
+        centres = [p for _, c, box in joined[:SPLIT_BLOBS] for p in disc_centres(c, box)]
         centres.sort(reverse=True)
         out: list[Features] = []
         for r, px, py in centres[:SPLIT_PEAKS]:
@@ -277,8 +277,11 @@ class HsvBlobDetector:
         cx, cy = int(px), int(py)
         x0, y0 = max(0, cx - pad), max(0, cy - pad)
         hsv, mask = self._window(image, bounds, x0, y0, min(w, cx + pad + 1), min(h, cy + pad + 1))
-        dist = cv2.distanceTransform(mask, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
-        opened = open_by_disc(mask, SPLIT_OPEN * (r + 1.0), dist)
+        # holes filled: a ball's highlight would pull the widest disc off its centre
+        solid = np.zeros_like(mask)
+        cv2.drawContours(solid, cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)[0], -1, 255, -1)
+        dist = cv2.distanceTransform(solid, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+        opened = open_by_disc(solid, SPLIT_OPEN * (r + 1.0), dist)
         # the widest disc near the search's centre: the ball, where the opening may leave shoulders of what
         # it is joined to (a neck wider than the opening's disc), which would pull an enclosing circle
         k = max(2, int(r / 3.0))
@@ -290,7 +293,7 @@ class HsvBlobDetector:
             if cv2.pointPolygonTest(c, centre, False) >= 0:
                 area = float(cv2.contourArea(c))
                 # joined to nothing (the opening only rounded its corners: a square), or too small
-                cut_off = cv2.countNonZero(mask) - cv2.countNonZero(opened)
+                cut_off = cv2.countNonZero(solid) - cv2.countNonZero(opened)
                 if len(c) < 8 or area < self.cfg.min_area or cut_off < SPLIT_CUT * area:
                     return None
                 # the ring on the unopened mask: what the opening cut off is still around the ball

@@ -77,13 +77,13 @@ def ellipse_support(pts: Points, real: Flags | None) -> float:
     return float(np.count_nonzero(inliers)) / len(fp)
 
 
-def disc_centres(mask: MatLike, contour: MatLike, box: tuple[int, int, int, int]) -> list[tuple[float, float, float]]:
+def disc_centres(contour: MatLike, box: tuple[int, int, int, int]) -> list[tuple[float, float, float]]:
     """The centres of the widest discs inside one blob (maxima of its distance transform, each at least its
     radius from a wider one), as (radius, x, y), widest first: where a ball joined to something else sits."""
     x, y, bw, bh = box
+    # filled: a ball's highlight is a hole in the mask, which would pull the disc off the ball's centre
     blob = np.zeros((bh + 2, bw + 2), np.uint8)  # a 1 px border: the distance reaches zero at the box's edge
     cv2.drawContours(blob, [contour], -1, 255, -1, offset=(1 - x, 1 - y))
-    blob[1:-1, 1:-1] &= np.asarray(mask, np.uint8)[y : y + bh, x : x + bw]  # the blob's holes stay holes
     dist = cv2.distanceTransform(blob, cv2.DIST_L2, 3)
     ys, xs = np.nonzero((dist >= cv2.dilate(dist, _PEAK_KERNEL)) & (dist >= PEAK_MIN))
     values = dist[ys, xs]
