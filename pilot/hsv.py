@@ -55,7 +55,7 @@ from cv2.typing import MatLike
 from .config import HsvConfig, VisionConfig
 from .detection import Candidate, Detection, best_detection, frame_size, range_of
 from .errors import ConfigError
-from .hsv_shape import RING_POINTS, disc_centres, ellipse_support, open_by_disc, outer_rim, share_set
+from .hsv_shape import ELLIPSE_ASPECT, RING_POINTS, disc_centres, ellipse_support, open_by_disc, outer_rim, share_set
 
 MAX_CANDIDATES = 4  # the largest search blobs refined; smaller ones cannot be the nearest target
 SEARCH_FILL = 0.45  # below FILL's zero: the search's coarser outline never rejects what the refinement keeps
@@ -331,7 +331,10 @@ class HsvBlobDetector:
         if real is not None:
             on_arc &= real
         arc = float(np.count_nonzero(on_arc)) / len(pts)
-        ellipse_arc = ellipse_support(pts, real) if arc < ARC[1] else 0.0
+        # an ellipse no longer than ELLIPSE_ASPECT fills at least 1 / ELLIPSE_ASPECT of its enclosing circle: a blob
+        # filling less has something sticking out, and an ellipse fitted to it is no evidence (a red lamp's
+        # outline passed as one: bench/vision, tuning gate sequences)
+        ellipse_arc = ellipse_support(pts, real) if arc < ARC[1] and fill >= 1.0 / ELLIPSE_ASPECT else 0.0
         hull = float(cv2.contourArea(cv2.convexHull(c)))
         solidity = area / hull if hull > 0 else 0.0
         geometry *= _arc_score(arc, ellipse_arc) * _ramp(solidity, *SOLIDITY)
