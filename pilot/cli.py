@@ -76,6 +76,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="simulated camera fault: black, saturated, frozen, small or grey, from START seconds "
                         "(or 'fire': when the laser first comes on), e.g. black@8+3")
     p.add_argument("--size", default="320x240", help="simulated camera frame size (default 320x240)")
+    p.add_argument("--readout-ms", type=float, default=0.0,
+                   help="simulated rolling shutter: ms from the top row to the bottom one (default 0: global shutter; "
+                        "a Raspberry Pi camera module reads out in about 20-30 ms)")
     p.add_argument("--virtual-drone", help="the virtual drone executable (default: the firmware's host build)")
     p.add_argument("--no-status", action="store_true", help="no status line")
     cal = p.add_argument_group("calibration")
@@ -117,6 +120,7 @@ def _check_args(args: argparse.Namespace) -> None:
         ("--max-seconds", args.max_seconds, 0.0 < args.max_seconds <= 86_400.0, "above 0 and at most 86400"),
         ("--wind", args.wind, 0.0 <= args.wind <= 50.0, "within 0..50"),
         ("--gusts", args.gusts, 0.0 <= args.gusts <= 20.0, "within 0..20"),
+        ("--readout-ms", args.readout_ms, 0.0 <= args.readout_ms <= 1000.0, "within 0..1000"),
         ("--baud", args.baud, 0 < args.baud <= 4_000_000, "within 1..4000000"),
     )
     for option, value, ok, allowed in checks:
@@ -220,7 +224,7 @@ def _fly_sim_with(args: argparse.Namespace, cfg: PilotConfig, observers: list[Ob
         config=cfg,
         max_seconds=args.max_seconds,
         record_dir=args.record,
-        camera=CameraModel(*_size(args.size)),
+        camera=CameraModel(*_size(args.size), readout_s=args.readout_ms / 1000.0),
         executable=args.virtual_drone,
         observers=observers,
         max_wind=args.wind,

@@ -3,8 +3,9 @@
 The mount sits on the airframe's nose and moves with it (lean, turn); the firmware's pan/tilt servo outputs
 turn it (at the spec's default angles it looks straight ahead along the airframe). The laser shares the
 camera's optical axis. Each frame: MuJoCo's offscreen render, then the sensor: auto-exposure, motion blur from
-the camera's actual angular rate over the exposure time, Gaussian noise growing with the gain (drawn once per
-seed and cycled), JPEG compression.
+the camera's actual angular rate over the exposure time, optionally a rolling shutter's skew (rows read one after
+another over ``readout_s``, each shifted by the image motion since the middle row), Gaussian noise growing with the
+gain (drawn once per seed and cycled), JPEG compression.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ class CameraModel:
     hfov_deg: float = 60.0
     target_brightness: float = 105.0  # auto-exposure's goal for the mean grey level
     max_gain: float = 4.0
+    readout_s: float = 0.0  # rolling shutter: top to bottom row (0: a global shutter, the campaign's camera)
 
     @property
     def focal(self) -> float:
@@ -116,9 +118,12 @@ class Sensor:
         wanted = cam.target_brightness / max(mean, 1.0) * self.gain
         self.gain += (min(cam.max_gain, max(0.5, wanted)) - self.gain) * 0.5  # auto-exposure settles in a few frames
         out = img
-        blur = self._blur_px(t)
+        flow = self._image_motion(t)
+        blur = None if flow is None else _blur_kernel(flow * self.sc.exposure_s)
         if blur is not None:
             out = np.asarray(cv2.filter2D(out, -1, blur), dtype=np.uint8)
+        if flow is not None and cam.readout_s > 0.0:
+            out = rolling_shutter(out, flow, cam.readout_s)
         if abs(self.gain - 1.0) > 1e-3:
             out = np.asarray(cv2.convertScaleAbs(out, alpha=self.gain, beta=0.0), dtype=np.uint8)
         if self._noise:
@@ -131,26 +136,43 @@ class Sensor:
             out = np.asarray(cv2.imdecode(data, cv2.IMREAD_COLOR), dtype=np.uint8)
         return out
 
-    def _blur_px(self, t: float) -> FloatArray | None:
-        """A line kernel along the image motion that the axis' angular rate makes over the exposure."""
+    def _image_motion(self, t: float) -> FloatArray | None:
+        """The image's motion (px/s, x right, y down) from the optical axis' angular rate since the last frame."""
         _, axis = self.axis()
         last, dt = self._last_axis, t - self._last_t
         self._last_axis, self._last_t = axis, t
         if last is None or dt <= 0.0:
             return None
         xmat = np.asarray(self.data.cam_xmat[self.cam_id]).reshape(3, 3)
-        moved = (axis - last) / dt * self.sc.exposure_s  # radians swept during the exposure, world frame
-        dx = float(moved @ xmat[:, 0]) * self.cam.focal
-        dy = -float(moved @ xmat[:, 1]) * self.cam.focal
-        length = math.hypot(dx, dy)
-        if length < 1.5:
-            return None
-        size = math.ceil(length) | 1
-        kernel = np.zeros((size, size))
-        c = size // 2
-        cv2.line(kernel, (round(c - dx / 2), round(c - dy / 2)), (round(c + dx / 2), round(c + dy / 2)), 1.0, 1)
-        total = float(kernel.sum())
-        return kernel / total if total > 0 else None
+        rate = (axis - last) / dt  # radians per second, world frame
+        return np.array([float(rate @ xmat[:, 0]), -float(rate @ xmat[:, 1])]) * self.cam.focal
 
     def close(self) -> None:
         self.renderer.close()
+
+
+def _blur_kernel(swept: FloatArray) -> FloatArray | None:
+    """A line kernel along ``swept`` (px moved during the exposure); None under 1.5 px."""
+    dx, dy = float(swept[0]), float(swept[1])
+    length = math.hypot(dx, dy)
+    if length < 1.5:
+        return None
+    size = math.ceil(length) | 1
+    kernel = np.zeros((size, size))
+    c = size // 2
+    cv2.line(kernel, (round(c - dx / 2), round(c - dy / 2)), (round(c + dx / 2), round(c + dy / 2)), 1.0, 1)
+    total = float(kernel.sum())
+    return kernel / total if total > 0 else None
+
+
+def rolling_shutter(img: Image, flow: FloatArray, readout_s: float) -> Image:
+    """Rows read top to bottom over ``readout_s``: each shows the scene as it stood when it was read, i.e. moved by
+    ``flow`` (px/s) times its delay from the middle row. Unchanged when no row would move by half a pixel."""
+    h, w = img.shape[:2]
+    if float(np.hypot(*flow)) * readout_s / 2.0 < 0.5:
+        return img
+    delay = ((np.arange(h, dtype=np.float32) + 0.5) / h - 0.5) * np.float32(readout_s)  # s, per row
+    xs = np.arange(w, dtype=np.float32)[None, :] - np.float32(flow[0]) * delay[:, None]
+    ys = np.arange(h, dtype=np.float32)[:, None] - np.float32(flow[1]) * delay[:, None] + np.zeros((1, w), np.float32)
+    out = cv2.remap(img, xs, ys, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+    return np.asarray(out, dtype=np.uint8)

@@ -64,6 +64,8 @@ def test_land_time_must_fit_the_firmware_landing_and_disarm() -> None:
         (["--wind", "nan"], "--wind"),
         (["--wind", "-1"], "--wind"),
         (["--baud", "0"], "--baud"),
+        (["--readout-ms", "nan"], "--readout-ms"),
+        (["--readout-ms", "-5"], "--readout-ms"),
         (["--size", "100000x100000"], "--size"),
         (["--size", "4097x240"], "--size"),
         (["--size", "16x16"], "--size"),

@@ -12,7 +12,7 @@ import pytest
 from pilot.detect import HsvBlobDetector
 from pilot.sim import mj, rc
 from pilot.sim.arducopter import FlightController, Mode, Sensors, desired_climb_rate, desired_lean
-from pilot.sim.camera import CameraModel
+from pilot.sim.camera import CameraModel, rolling_shutter
 from pilot.sim.physics import Airframe
 from pilot.sim.room import SCENARIOS, make_scenario
 from pilot.sim.scene import HIDDEN_GROUP, build
@@ -215,3 +215,29 @@ def test_the_crash_check_disarms_an_airframe_stuck_off_its_attitude() -> None:
     for _ in range(round(0.2 / 0.002)):
         demand = fc.step(pulses, stuck, 0.002)
     assert not fc.armed and not demand.motors_on
+
+
+def test_a_rolling_shutter_shears_a_moving_image_by_each_row_s_delay() -> None:
+    img = np.zeros((240, 320, 3), np.uint8)
+    img[:, 160] = 255  # a vertical line; the image moves right at 600 px/s, rows read over 30 ms
+    out = rolling_shutter(img, np.array([600.0, 0.0]), 0.03)
+    for row in (0, 120, 239):
+        delay = ((row + 0.5) / 240 - 0.5) * 0.03
+        assert abs(int(np.argmax(out[row, :, 0])) - (160 + 600.0 * delay)) <= 1
+    assert rolling_shutter(img, np.array([10.0, 0.0]), 0.03) is img  # under half a pixel: untouched
+
+
+def test_the_rolling_shutter_option_changes_only_frames_taken_while_turning() -> None:
+    sc = make_scenario("ahead", 2, noise=False)
+    x, y, heading = sc.start
+    frames: dict[float, list[np.ndarray]] = {}
+    for readout in (0.0, 0.03):
+        view = StillView(sc, CameraModel(320, 240, readout_s=readout))
+        shots = []
+        for k, turn in enumerate((0.0, 0.0, 0.05)):  # still, still, then 2.9° in 50 ms: 57°/s
+            view.place(x, y, 1.2, heading + turn)
+            shots.append(view.render(0.05 * k))
+        view.close()
+        frames[readout] = shots
+    assert np.array_equal(frames[0.0][1], frames[0.03][1])  # not turning: a global and a rolling shutter agree
+    assert not np.array_equal(frames[0.0][2], frames[0.03][2])
