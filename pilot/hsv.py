@@ -31,15 +31,14 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
    The circle, not the blob's centroid, gives the position: a ball's dark side or a covered part moves
    a centroid, not the circle through its rim.
 3. Split: a ball in front of something of its colour (a red motorbike, a red-brown saucer) joins it in the
-   mask, and the joined blob is no disc. Unless a candidate already scores ``SPLIT_UNLESS``, the largest search
-   blobs filling less than ``SPLIT_FILL`` of their box's disc are searched for the widest discs inside them
-   (maxima of the distance transform); around each, at full resolution, the mask is opened by a disc
-   ``SPLIT_OPEN`` as wide, which cuts necks and keeps the ball whole, and the piece holding the centre is
-   measured as above, its arcs counting only where its outline is the mask's real edge, not a cut (an opened
-   square is round).
+   mask. Unless a candidate already scores ``SPLIT_UNLESS``, the largest search blobs filling less than
+   ``SPLIT_FILL`` of their box's disc are split (pilot/hsv_split.py): by shape, around the widest discs that
+   bulge out of them, the mask opened by a disc half as wide (necks go, the ball stays whole; its arcs count
+   only on the mask's real edge, as an opened square is round); and by hue, when their pixels fall in two hue
+   classes (a ball a few units off a red-brown saucer), each class's round pieces refined in its own range.
 
-A blob at least ``HALF_MEASURE`` px across is measured on the search itself (half resolution shows its shape
-well enough), which saves the refinement's fixed cost.
+A search blob from ``HALF_TRY`` px across is first measured on the search itself: a plain disc scoring high
+there, or any blob from ``HALF_MEASURE`` px, skips the refinement and its fixed cost.
 """
 
 from __future__ import annotations
@@ -55,7 +54,8 @@ from cv2.typing import MatLike
 from .config import HsvConfig, VisionConfig
 from .detection import Candidate, Detection, best_detection, frame_size, range_of
 from .errors import ConfigError
-from .hsv_shape import ELLIPSE_ASPECT, RING_POINTS, disc_centres, ellipse_support, open_by_disc, outer_rim, share_set
+from .hsv_shape import ELLIPSE_ASPECT, RING_POINTS, ellipse_support, outer_rim, share_set
+from .hsv_split import disc_centres, hue_split, round_pieces, split_off
 
 MAX_CANDIDATES = 4  # the largest search blobs refined; smaller ones cannot be the nearest target
 SEARCH_FILL = 0.45  # below FILL's zero: the search's coarser outline never rejects what the refinement keeps
@@ -67,9 +67,12 @@ V_FLOOR = 24  # the V bound never drops below this: under it hue and saturation 
 SPLIT_FILL = 0.75  # a search blob filling less of its box's disc may be a ball joined to something
 SPLIT_BLOBS = 3  # the largest such blobs searched for discs
 SPLIT_PEAKS = 4  # disc centres refined per frame, widest first
-SPLIT_OPEN = 0.5  # the opening's disc, in radii of the disc found (0.6 let opened squares through: red_shape)
-SPLIT_CUT = 0.1  # the opening must cut off this much (of the piece's area): else the blob was joined to nothing
-SPLIT_UNLESS = 0.8  # a candidate scoring this already: no split (it costs ~0.3 ms a window)
+HUE_PIECES = 2  # the largest round pieces of each hue class refined
+HALF_TRY = 24  # px across: a smaller search blob is only refined
+HALF_DECIDES = 0.9  # the half-resolution score that keeps a blob from the refinement...
+HALF_FILL = 0.8  # ...for a plain disc only: this fill of its circle (a square's is 0.64)...
+HALF_ARC = 0.8  # ...and this share of its outline on it
+SPLIT_UNLESS = 0.8  # a candidate scoring this already: no split (0.1-0.3 ms a disc or piece refined)
 RIM_STEP = 2.0  # px outwards from a contour point where the unopened mask must be unset for a real edge
 # score ramps (zero, one), set on the tuning photos only (bench/vision/RESULTS.md)
 ARC = (0.3, 0.6)
@@ -110,6 +113,11 @@ def _ramp(value: float, zero: float, one: float) -> float:
 
 def _arc_score(arc: float, ellipse_arc: float) -> float:
     return max(_ramp(arc, *ARC), _ramp(ellipse_arc, *ELLIPSE_ARC))
+
+
+def _new(f: Features, found: list[Features]) -> bool:
+    """Not within a pixel of one already found (windows overlap; the splits find blobs the search found)."""
+    return all(abs(f.cx - g.cx) > 1.0 or abs(f.cy - g.cy) > 1.0 for g in found)
 
 
 def _contiguous(hues: set[int]) -> tuple[int, int] | None:
@@ -225,27 +233,60 @@ class HsvBlobDetector:
         boxes.sort(key=lambda b: b[0], reverse=True)
         found: list[Features] = []
         for area, c, (x, y, bw, bh) in boxes[:MAX_CANDIDATES]:
-            if scale > 1 and max(bw, bh) * scale >= HALF_MEASURE:
-                f = self._measure(small_hsv, mask, c, area, 0, 0, scale=scale)
-                fs = [] if f is None else [f]
+            across = max(bw, bh) * scale if scale > 1 else 0  # searched at full resolution: refined as it is
+            half = self._measure(small_hsv, mask, c, area, 0, 0, scale=scale) if across >= HALF_TRY else None
+            if across >= HALF_MEASURE:
+                fs = [] if half is None else [half]
+            elif half is not None and self._plain_disc(half, w):
+                fs = [half]
             else:
                 fs = self._refine(image, bounds, (x * scale, y * scale, bw * scale, bh * scale))
-            found += [f for f in fs if all(abs(f.cx - g.cx) > 1.0 or abs(f.cy - g.cy) > 1.0 for g in found)]
+            found += [f for f in fs if _new(f, found)]
         if joined and not any(self.score(f, w) >= SPLIT_UNLESS for f in found):
+            joined.sort(key=lambda b: b[0], reverse=True)
             found += self._split(image, bounds, joined, scale, found)
+            if len(bounds) == 1:
+                found += self._hue_split(image, bounds, small_hsv, mask, joined, scale, found)
         return found
+
+    def _plain_disc(self, f: Features, width: int) -> bool:
+        """A blob measured at half resolution that needs no refinement: a plain disc scoring high."""
+        return f.fill >= HALF_FILL and f.arc >= HALF_ARC and self.score(f, width) >= HALF_DECIDES
+
+    def _hue_split(self, image: MatLike, bounds: Bounds, hsv: MatLike, mask: MatLike,
+                   joined: list[tuple[float, MatLike, Box]], scale: int, found: list[Features]) -> list[Features]:
+        """Balls a few hue units off what they are joined to (a red ball on a red-brown saucer): each joined
+        blob whose pixels fall in two hue classes is searched again in each class's hue range, and its round
+        pieces refined in that range (their rings then see only their own hue). One range only (see __init__)."""
+        ((lo, hi),) = bounds
+        min_area = self.cfg.min_area / (scale * scale)
+        out: list[Features] = []
+        for _, c, (x, y, bw, bh) in joined[:SPLIT_BLOBS]:
+            blob = np.zeros((bh, bw), np.uint8)
+            cv2.drawContours(blob, [c], -1, 255, -1, offset=(-x, -y))
+            window = np.asarray(hsv, np.uint8)[y : y + bh, x : x + bw]
+            blob &= np.asarray(mask, np.uint8)[y : y + bh, x : x + bw]
+            t = hue_split(np.ascontiguousarray(window[..., 0]), blob, 4 * min_area)
+            if t is None:
+                continue
+            for h0, h1 in ((int(lo[0]), t), (t + 1, int(hi[0]))):
+                sub_lo, sub_hi = lo.copy(), hi.copy()
+                sub_lo[0], sub_hi[0] = h0, h1
+                sub = self._clean(cv2.bitwise_and(cv2.inRange(window, sub_lo, sub_hi), blob))
+                for _, (px, py, pw, ph) in round_pieces(sub, min_area, SEARCH_FILL)[:HUE_PIECES]:
+                    box = ((px + x) * scale, (py + y) * scale, pw * scale, ph * scale)
+                    out += [f for f in self._refine(image, [(sub_lo, sub_hi)], box) if _new(f, found + out)]
+        return out
 
     def _split(self, image: MatLike, bounds: Bounds, joined: list[tuple[float, MatLike, Box]],
                scale: int, found: list[Features]) -> list[Features]:
         """Balls joined to something of their colour: the widest discs of the largest joined blobs, refined."""
-        joined.sort(key=lambda b: b[0], reverse=True)
-        centres = [p for _, c, box in joined[:SPLIT_BLOBS] for p in disc_centres(c, box)]
-        centres.sort(reverse=True)
+        centres = sorted((p for _, c, box in joined[:SPLIT_BLOBS] for p in disc_centres(c, box)), reverse=True)
         out: list[Features] = []
+        half = (scale - 1) / 2.0
         for r, px, py in centres[:SPLIT_PEAKS]:
-            half = (scale - 1) / 2.0
             f = self._refine_disc(image, bounds, px * scale + half, py * scale + half, r * scale)
-            if f is not None and all(abs(f.cx - g.cx) > 1.0 or abs(f.cy - g.cy) > 1.0 for g in found + out):
+            if f is not None and _new(f, found + out):
                 out.append(f)
         return out
 
@@ -271,36 +312,19 @@ class HsvBlobDetector:
         return [f for f in found if f is not None]
 
     def _refine_disc(self, image: MatLike, bounds: Bounds, px: float, py: float, r: float) -> Features | None:
-        """The piece of the mask around a disc centre that an opening by a disc SPLIT_OPEN as wide leaves."""
+        """The piece of the mask around a disc centre that an opening leaves (pilot/hsv_split.py), measured."""
         w, h = frame_size(image)
         pad = int(2.0 * r) + 6  # the ring reaches 1.75 radii
         cx, cy = int(px), int(py)
         x0, y0 = max(0, cx - pad), max(0, cy - pad)
         hsv, mask = self._window(image, bounds, x0, y0, min(w, cx + pad + 1), min(h, cy + pad + 1))
-        # holes filled: a ball's highlight would pull the widest disc off its centre
-        solid = np.zeros_like(mask)
-        cv2.drawContours(solid, cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)[0], -1, 255, -1)
-        dist = cv2.distanceTransform(solid, cv2.DIST_L2, 5)  # within 2 % of the precise one, at a third of its cost
-        opened = open_by_disc(solid, SPLIT_OPEN * (r + 1.0), dist)
-        # the widest disc near the search's centre: the ball, where the opening may leave shoulders of what
-        # it is joined to (a neck wider than the opening's disc), which would pull an enclosing circle
-        k = max(2, int(r / 3.0))
-        near = dist[max(0, cy - y0 - k) : cy - y0 + k + 1, max(0, cx - x0 - k) : cx - x0 + k + 1]
-        _, r_in, _, (mx, my) = cv2.minMaxLoc(near)
-        centre = (float(mx + max(0, cx - x0 - k)), float(my + max(0, cy - y0 - k)))  # in the window
-        contours, _ = cv2.findContours(opened, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
-        for c in contours:
-            if cv2.pointPolygonTest(c, centre, False) >= 0:
-                area = float(cv2.contourArea(c))
-                # joined to nothing (the opening only rounded its corners: a square), or too small
-                cut_off = cv2.countNonZero(solid) - cv2.countNonZero(opened)
-                if len(c) < 8 or area < self.cfg.min_area or cut_off < SPLIT_CUT * area:
-                    return None
-                # the ring on the unopened mask: what the opening cut off is still around the ball
-                f = self._measure(hsv, mask, c, area, x0, y0, cut=True)
-                # a drawn disc 2 R + 1 px across reads R at its centre
-                return None if f is None else f._replace(cx=centre[0] + x0, cy=centre[1] + y0, size=2.0 * r_in + 1.0)
-        return None
+        piece = split_off(mask, cx - x0, cy - y0, r, self.cfg.min_area)
+        if piece is None:
+            return None
+        # the ring on the unopened mask: what the opening cut off is still around the ball
+        f = self._measure(hsv, mask, piece.contour, piece.area, x0, y0, cut=True)
+        # the widest disc gives the position and size (a drawn disc 2 R + 1 px across reads R at its centre)
+        return None if f is None else f._replace(cx=piece.cx + x0, cy=piece.cy + y0, size=2.0 * piece.radius + 1.0)
 
     def _measure(self, hsv: MatLike, mask: MatLike, c: MatLike, area: float, x0: int, y0: int,
                  scale: int = 1, cut: bool = False) -> Features | None:

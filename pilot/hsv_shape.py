@@ -1,5 +1,5 @@
 """Shape measures for the colour-ball detector (pilot/hsv.py) that do not depend on colour: sampled rings, the
-support of a robustly fitted ellipse, disc centres in a blob, and an opening by a disc of any size."""
+real edge of a piece an opening left, and the support of a robustly fitted ellipse."""
 
 from __future__ import annotations
 
@@ -16,16 +16,10 @@ Flags = npt.NDArray[np.bool_]
 
 ELLIPSE_TOL = 0.06  # a point within this share of the mean radius (at least 1 px) lies on the fitted ellipse
 ELLIPSE_ASPECT = 1.5  # a longer fit is no ball seen at an angle (the elongation ramp's zero is 2.0)
-PEAK_MIN = 3.0  # pixels: a disc centre nearer than this to the blob's edge is too small to be a ball
-PEAKS_PER_BLOB = 6  # disc centres looked at per blob, widest first
-RIM_MIN = 0.35  # of a circle just outside a disc that leaves the blob: less is no bulge (a disc that merely
-# fits inside a wide region has its nearest edge on one side); it halves the discs refined, not the recall
 
 # the ring from 1.25 to 1.75 radii, in radii: three circles of 48 points (sampling it costs a third of drawing it)
 _ANGLES = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
 RING_POINTS = np.concatenate([k * np.stack([np.cos(_ANGLES), np.sin(_ANGLES)], axis=1) for k in (1.33, 1.5, 1.67)])
-_PEAK_KERNEL = np.ones((3, 3), np.uint8)
-_CIRCLE = np.stack([np.cos(_ANGLES[::2]), np.sin(_ANGLES[::2])], axis=1)  # 24 points
 
 
 def share_set(mask: MatLike, cx: float, cy: float, unit: npt.NDArray[np.float64], r: float) -> float:
@@ -78,41 +72,3 @@ def ellipse_support(pts: Points, real: Flags | None) -> float:
     if real is not None:
         inliers &= real
     return float(np.count_nonzero(inliers)) / len(fp)
-
-
-def disc_centres(contour: MatLike, box: tuple[int, int, int, int]) -> list[tuple[float, float, float]]:
-    """The centres of the widest discs inside one blob (maxima of its distance transform, each at least its
-    radius from a wider one) that bulge out of it (``RIM_MIN``), as (radius, x, y), widest first: where a ball
-    joined to something else sits."""
-    x, y, bw, bh = box
-    # filled: a ball's highlight is a hole in the mask, which would pull the disc off the ball's centre
-    blob = np.zeros((bh + 2, bw + 2), np.uint8)  # a 1 px border: the distance reaches zero at the box's edge
-    cv2.drawContours(blob, [contour], -1, 255, -1, offset=(1 - x, 1 - y))
-    dist = cv2.distanceTransform(blob, cv2.DIST_L2, 3)
-    ys, xs = np.nonzero((dist >= cv2.dilate(dist, _PEAK_KERNEL)) & (dist >= PEAK_MIN))
-    values = dist[ys, xs]
-    out: list[tuple[float, float, float]] = []
-    for k in np.argsort(-values):
-        r, px, py = float(values[k]), float(xs[k]), float(ys[k])
-        if all((px - qx) ** 2 + (py - qy) ** 2 > max(r, qr) ** 2 for qr, qx, qy in out):
-            out.append((r, px, py))
-            if len(out) >= PEAKS_PER_BLOB:
-                break
-    vetted = []
-    for r, px, py in out:
-        pos = (_CIRCLE * (r + 1.5) + (px + 0.5, py + 0.5)).astype(np.intp)  # + 0.5: truncation rounds
-        pos = pos[(pos[:, 0] >= 0) & (pos[:, 0] < bw + 2) & (pos[:, 1] >= 0) & (pos[:, 1] < bh + 2)]
-        rim = 1.0 - float(np.count_nonzero(blob[pos[:, 1], pos[:, 0]])) / len(_CIRCLE)  # beyond the box: outside
-        if rim >= RIM_MIN:
-            vetted.append((r, px + x - 1, py + y - 1))
-    return vetted
-
-
-def open_by_disc(mask: MatLike, radius: float, dist: MatLike) -> MatLike:
-    """The mask opened by a disc of ``radius``, given the mask's distance transform: necks and strips narrower
-    than the disc go, any wider disc stays whole. Two distance transforms, whatever the radius (a structuring
-    element that size would cost far more)."""
-    _, core = cv2.threshold(np.asarray(dist, np.float32), radius, 255, cv2.THRESH_BINARY_INV)
-    _, opened = cv2.threshold(cv2.distanceTransform(core.astype(np.uint8), cv2.DIST_L2, 3), radius, 255,
-                              cv2.THRESH_BINARY_INV)
-    return opened.astype(np.uint8)
