@@ -332,9 +332,10 @@ class HsvBlobDetector:
         ``scale``: the mask is the search's, that many times smaller than the frame; ``cut``: the blob is a piece
         an opening left, and only its outline on the mask's real edge counts for its arcs."""
         (cx, cy), r = cv2.minEnclosingCircle(c)
-        # the circle passes through pixel centres; the ball covers the pixels. At half resolution a pixel a
-        # third covered by the ball already passes the mask: its circle runs ~0.4 px outside (4 r - 1, not + 2)
-        size = 2.0 * r * scale + 1.0 - 2.0 * (scale - 1)
+        # the circle passes through pixel centres; the ball covers the pixels. At half resolution a flat disc's
+        # edge pixels pass the mask a third covered (4 r - 1.7 fits), a shaded ball's dark rim fails it (4 r + 1
+        # on the tuning photos): 4 r, in between (the flights' approach rests on this size)
+        size = 2.0 * r * scale + 1.0 - (scale - 1)
         (_, _), (rw, rh), _ = cv2.minAreaRect(c)
         elongation = max(rw, rh) / max(1e-6, min(rw, rh))
         fill = area / (math.pi * r * r) if r > 0 else 0.0
