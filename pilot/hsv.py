@@ -145,6 +145,9 @@ class HsvBlobDetector:
         span = _contiguous(hues)
         if span is None and _contiguous(mirrored) is not None:
             span, self._code = _contiguous(mirrored), cv2.COLOR_RGB2HSV
+            # each range mirrored too (a range holding hue 120 is not in one piece mirrored: the union then is not)
+            ranges = [(np.array(((120 - hi[0]) % 180, *lo[1:]), np.uint8),
+                       np.array(((120 - lo[0]) % 180, *hi[1:]), np.uint8)) for lo, hi in cfg.ranges]
         if span is not None and len(sv) == 1:
             ((s_lo, v_lo), (s_hi, v_hi)), = sv
             ranges = [(np.array((span[0], s_lo, v_lo), np.uint8), np.array((span[1], s_hi, v_hi), np.uint8))]
@@ -237,7 +240,7 @@ class HsvBlobDetector:
             half = self._measure(small_hsv, mask, c, area, 0, 0, scale=scale) if across >= HALF_TRY else None
             if across >= HALF_MEASURE:
                 fs = [] if half is None else [half]
-            elif half is not None and self._plain_disc(half, w):
+            elif half and half.fill >= HALF_FILL and half.arc >= HALF_ARC and self.score(half, w) >= HALF_DECIDES:
                 fs = [half]
             else:
                 fs = self._refine(image, bounds, (x * scale, y * scale, bw * scale, bh * scale))
@@ -248,10 +251,6 @@ class HsvBlobDetector:
             if len(bounds) == 1:
                 found += self._hue_split(image, bounds, small_hsv, mask, joined, scale, found)
         return found
-
-    def _plain_disc(self, f: Features, width: int) -> bool:
-        """A blob measured at half resolution that needs no refinement: a plain disc scoring high."""
-        return f.fill >= HALF_FILL and f.arc >= HALF_ARC and self.score(f, width) >= HALF_DECIDES
 
     def _hue_split(self, image: MatLike, bounds: Bounds, hsv: MatLike, mask: MatLike,
                    joined: list[tuple[float, MatLike, Box]], scale: int, found: list[Features]) -> list[Features]:
@@ -332,9 +331,8 @@ class HsvBlobDetector:
         ``scale``: the mask is the search's, that many times smaller than the frame; ``cut``: the blob is a piece
         an opening left, and only its outline on the mask's real edge counts for its arcs."""
         (cx, cy), r = cv2.minEnclosingCircle(c)
-        # the circle passes through pixel centres; the ball covers the pixels. At half resolution a flat disc's
-        # edge pixels pass the mask a third covered (4 r - 1.7 fits), a shaded ball's dark rim fails it (4 r + 1
-        # on the tuning photos): 4 r, in between (the flights' approach rests on this size)
+        # the circle passes through pixel centres; the ball covers the pixels. At half resolution: 4 r, between a
+        # flat disc's 4 r - 1.7 and a shaded ball's 4 r + 1 (tuning photos; the flights' approach rests on it)
         size = 2.0 * r * scale + 1.0 - (scale - 1)
         (_, _), (rw, rh), _ = cv2.minAreaRect(c)
         elongation = max(rw, rh) / max(1e-6, min(rw, rh))
@@ -356,9 +354,8 @@ class HsvBlobDetector:
         if real is not None:
             on_arc &= real
         arc = float(np.count_nonzero(on_arc)) / len(pts)
-        # an ellipse no longer than ELLIPSE_ASPECT fills at least 1 / ELLIPSE_ASPECT of its enclosing circle: a blob
-        # filling less has something sticking out, and an ellipse fitted to it is no evidence (a red lamp's
-        # outline passed as one: bench/vision, tuning gate sequences)
+        # an ellipse no longer than ELLIPSE_ASPECT fills 1 / ELLIPSE_ASPECT of its enclosing circle or more: a blob
+        # filling less has something sticking out (a red lamp on the tuning photos' motorbike passed as an ellipse)
         ellipse_arc = ellipse_support(pts, real) if arc < ARC[1] and fill >= 1.0 / ELLIPSE_ASPECT else 0.0
         hull = float(cv2.contourArea(cv2.convexHull(c)))
         solidity = area / hull if hull > 0 else 0.0

@@ -137,6 +137,19 @@ def test_hsv_both_hue_ranges_are_needed() -> None:
     assert only_second.detect(high_red).found and not only_second.detect(low_red).found
 
 
+
+def test_hsv_red_ranges_with_their_own_bounds() -> None:
+    """Two red ranges with different S bounds cannot be merged into one mask; each is mirrored with the frame
+    (red in one piece at hue 120) and the ball is found, scored as pure red."""
+    cfg = HsvConfig(ranges=(((0, 120, 70), (6, 255, 255)), ((174, 100, 70), (179, 255, 255))))
+    det = HsvBlobDetector(cfg)
+    assert not det.single_range
+    for bgr in ((10, 20, 220), (40, 15, 220)):  # hue near 2, near 176
+        img = synth.background(320, 240)
+        cv2.circle(img, (150, 110), 20, bgr, -1, cv2.LINE_AA)
+        d = det.detect(img)
+        assert d.found and d.confidence >= 0.85 and abs(d.cx - 150) <= 1.5 and abs(d.cy - 110) <= 1.5, (bgr, d)
+
 def test_detection_errors_normalised() -> None:
     det = HsvBlobDetector(HsvConfig())
     d = det.detect(synth.red_disc(synth.background(320, 240), 240, 60, 10))
