@@ -74,6 +74,11 @@ RETURN_TOL_M = 0.05  # a search's return to the height the target was seen from 
 RETURN_MAX_MS = 3000  # ... or this long after the search began
 
 
+def _brake_steps(speed: float) -> float:
+    """The pitch-back stick, in speed steps, against a closing speed: harder the faster it closes, up to 1.4."""
+    return min(1.4, 0.8 + speed)
+
+
 class Controller(ControllerCore):
     def __init__(self, config: ControllerConfig | None = None, clock: Callable[[], float] = time.monotonic) -> None:
         super().__init__(config, clock)
@@ -83,6 +88,9 @@ class Controller(ControllerCore):
         # frame's edge) shrinks in its last frames, and the short fit then reads a closing speed near zero
         self.closing_trend = ClosingSpeed(window_s=1.2, min_samples=8)
         self.momentum = Momentum(self.cfg.pitch_accel_mps2)
+        # the same from the commands alone, never reset by vision: a target being covered keeps its size while the
+        # drone flies on, and vision's speed then drops to zero just before the loss
+        self.reckoned = Momentum(self.cfg.pitch_accel_mps2)
         self.lean = Lean(self.cfg.pitch_accel_mps2)
         self.height = Height(self.cfg.climb_mps_per_step)
         self.seen_from = SeenFrom()
@@ -105,9 +113,9 @@ class Controller(ControllerCore):
         return self._emit(dp.move_forward(speed_for(dp.CommandName.MOVE_FORWARD, min(1.2, 0.6 - closing))))
 
     def _brake(self, speed: float, det: Detection | None = None) -> bytes:
-        """Pitch back against a closing speed: harder the faster it closes, up to 1.4 speed steps, and with the
-        target in view no harder than keeps it in the frame (the nose comes up with the brake, see ``_brake_room``)."""
-        frac = min(1.4, 0.8 + speed)
+        """Pitch back against a closing speed (``_brake_steps``), with the target in view no harder than keeps it in
+        the frame (the nose comes up with the brake, see ``_brake_room``)."""
+        frac = _brake_steps(speed)
         if det is not None and det.found:
             frac = max(MIN_BRAKE, min(frac, self._brake_room(det)))
         return self._emit(dp.move_backward(speed_for(dp.CommandName.MOVE_BACKWARD, frac)))
@@ -125,6 +133,7 @@ class Controller(ControllerCore):
         held = self.sticks.pitch(now)
         dt = (now - self._last_ms) / 1000.0
         self.momentum.advance(held, dt)
+        self.reckoned.advance(held, dt)
         self.lean.advance(held, dt)
         self.height.advance(self.sticks.throttle(now), dt)
         self._last_ms = now
@@ -136,6 +145,7 @@ class Controller(ControllerCore):
             self.closing.reset()
             self.closing_trend.reset()
             self.momentum.reset()
+            self.reckoned.reset()
         cx = det.cx if det is not None and det.found and not det.predicted else None
         if self.state is not State.TRACK:
             self.response.reset()
@@ -232,10 +242,14 @@ class Controller(ControllerCore):
         """Target lost: laser off first, then sticks neutral, then the servos home, then search; lost while
         closing in, the search starts by braking for as long as the last closing speed needs."""
         off = self._laser(False)
-        # vision's last estimate carried on by dead reckoning, or the longer trend if that is faster
-        closing = max(self.momentum.speed, self.closing_trend.closing or 0.0)
+        # vision's last estimate carried on by dead reckoning, the commands' own reckoning, or the longer trend:
+        # whichever is fastest
+        closing = max(self.momentum.speed, self.reckoned.speed, self.closing_trend.closing or 0.0)
         if closing > 0.15:
-            self._brake_until_ms = self._now() + round(1000.0 * closing / self.cfg.brake_mps2)
+            # as long as that brake takes to stop it (plus the lean's lag), not longer: a brake held on flies the
+            # drone backwards into whatever is behind it, where the camera does not look
+            decel = self.cfg.pitch_accel_mps2 * _brake_steps(closing)
+            self._brake_until_ms = self._now() + round(1000.0 * (closing / decel + self.lean.lag_s))
             self._brake_speed = closing
         self._go(State.SEARCH, reason)
         return off if off is not None else self._emit(dp.hold_altitude())
@@ -277,7 +291,9 @@ class Controller(ControllerCore):
             self._go(State.AIM, f"close enough (size {size:.3f})")
             return self._on_aim(det)
         closing, allowed = self.closing.closing, cfg.approach_speed_mps
-        if closing is not None and det.range_m > 0.0:
+        if closing is None:  # too few consistent ranges yet: the speed its own pitch commands gave it
+            closing = self.momentum.speed
+        if det.range_m > 0.0:
             # the range still to go before the aim range (range scales as 1/size), and the speed allowed there
             allowed = allowed_speed(det.range_m * (1.0 - size / cfg.approach_size), cfg.brake_mps2,
                                     cfg.approach_speed_mps)
@@ -293,7 +309,7 @@ class Controller(ControllerCore):
             if ey < 0:
                 return self._emit(dp.move_up(speed_for(dp.CommandName.MOVE_UP, frac)))
             return self._emit(dp.move_down(speed_for(dp.CommandName.MOVE_DOWN, frac)))
-        if closing is not None and closing > allowed - 0.1:
+        if closing > allowed - 0.1:
             return self._emit(dp.hold_altitude())  # coasting at about the right speed
         frac = 1.8 if size < 0.45 * cfg.approach_size else (1.0 if size < 0.75 * cfg.approach_size else 0.6)
         self._coast = self._emit(dp.move_forward(speed_for(dp.CommandName.MOVE_FORWARD, frac)))

@@ -94,7 +94,28 @@ def test_a_target_that_stops_shrinking_before_it_is_lost_still_gets_its_brake() 
     brakes = 0
     while name(rig.tick(MISS)) == "move_backward":
         brakes += 1
-    assert brakes * 50 >= 600  # the trend: about 0.4 m/s at 0.5 m/s² (dead reckoning alone: 0.15 m/s, 0.3 s)
+    assert brakes * 50 >= 600  # the trend: about 0.4 m/s, 0.6 s at the brake's deceleration (vision alone: 0.15 m/s)
+
+
+def test_a_target_covered_while_the_drone_pushes_forward_still_gets_the_brake_its_commands_call_for() -> None:
+    """A target sliding behind a cover reads the same size for its last frames while the drone, pitched forward,
+    flies on: vision's speed and its 1.2 s trend both drop, the commands' own reckoning does not."""
+    c, rig = to_state(State.TRACK)
+    r = 3.0
+    for _ in range(30):  # 1.5 s of one range, and TRACK pushing forward all along
+        rig.tick(seen(size=size_at(r)))
+    assert c.closing.closing is not None and abs(c.closing.closing) < 0.05
+    assert c.reckoned.speed > 0.5
+    while st(c) is not State.SEARCH:
+        rig.tick(MISS)
+    speed = c.reckoned.speed
+    brakes = 0
+    while name(rig.tick(MISS)) == "move_backward":
+        brakes += 1
+    # vision's estimate alone gave no brake at all; this one lasts as long as its own deceleration needs to stop
+    # that speed, plus the lean's lag, and no longer (held on, it would fly the drone backwards)
+    stop_s = speed / (CFG.pitch_accel_mps2 * min(1.4, 0.8 + speed)) + c.lean.lag_s
+    assert abs(brakes * 0.05 - stop_s) <= 0.1
 
 
 def test_the_lean_follows_the_pitch_stick_with_a_lag() -> None:
