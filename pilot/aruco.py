@@ -99,3 +99,7 @@ class ArucoMarkerDetector:
     def detect(self, image: MatLike) -> Detection:
         """This frame alone, the best candidate (no tracking, no frame checks)."""
         return best_detection(self, image, self.cfg.marker_size_m, self.fov_deg)
+
+    def aim_on_target(self, image: MatLike, size: float) -> bool | None:
+        """Not measured: a marker is black and white like much else, and a marker partly covered is not read."""
+        return None

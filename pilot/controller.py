@@ -36,7 +36,9 @@ States (``State``)::
   far target flickers in and out of detection).
 * AIM holds position and centres the target with the pan/tilt servos (only from measured sightings: a
   tracker's prediction knows nothing of the step just sent); after ``aim_frames`` centred
-  frames FIRE switches the laser on. The laser stays on only while the target is found, centred and in range;
+  frames FIRE switches the laser on (not while the detector sees something else at the aim point: a thing in
+  front of the target hides its middle while the circle through its rim stays centred). The laser stays on only
+  while the target is found, centred, in range and clear at the aim point;
   after ``fire_ms`` lit (as the drone confirmed it) it is switched off and the drone lands. While
   firing, small errors (within twice the aim tolerance) are still corrected
   with the servos; larger ones switch the laser off and go back to AIM.
@@ -344,7 +346,8 @@ class Controller(ControllerCore):
             self._centred = 0
             return correction
         self._centred += 1
-        if self._centred >= self.cfg.aim_frames and self.gate.confirmed():  # vision gate: confirmed to fire
+        # vision gate: confirmed to fire, and nothing in front of the target's middle where the ray goes
+        if self._centred >= self.cfg.aim_frames and self.gate.confirmed() and det.aim_on_target is not False:
             self._go(State.FIRE, "locked and centred")
             self._fire_started_ms = self._now()
             self.lit_ms = 0
@@ -372,9 +375,11 @@ class Controller(ControllerCore):
         self._remember_side(det)
         loose = 2.0 * self.cfg.aim_tolerance
         far = det.relative_size < self.cfg.retreat_size  # drifted back out of range (AIM approaches again)
-        if far or abs(det.error_x) > loose or abs(det.error_y) > loose:
+        blocked = det.aim_on_target is False  # something in front of the target, where the ray goes
+        if far or blocked or abs(det.error_x) > loose or abs(det.error_y) > loose:
             off = self._laser(False)
-            self._go(State.AIM, "out of range while firing" if far else "off centre while firing")
+            why = "out of range" if far else ("something in front of the target" if blocked else "off centre")
+            self._go(State.AIM, f"{why} while firing")
             return off if off is not None else self._on_aim(det)
         if not self.gate.confirmed():  # vision gate: found, but not confirmed in enough frames in a row
             off = self._laser(False)

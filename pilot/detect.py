@@ -55,7 +55,9 @@ class TrackedDetector:
             return Detection(False, width=w, height=h)
         c = out.candidate
         distance = range_of(c.size, self.object_m, w, self.fov_deg)
-        return Detection(True, c.cx, c.cy, c.size, c.score, w, h, range_m=distance, predicted=out.predicted)
+        aim = None if out.predicted else self.source.aim_on_target(image, c.size)
+        return Detection(True, c.cx, c.cy, c.size, c.score, w, h, range_m=distance, predicted=out.predicted,
+                         aim_on_target=aim)
 
 
 def make_detector(config: PilotConfig) -> TrackedDetector:

@@ -43,6 +43,7 @@ class Detection:
     range_m: float = 0.0  # estimated from the apparent size and the target's known size (0: unknown)
     status: FrameStatus = FrameStatus.OK
     predicted: bool = False  # bridged by the tracker through a missed frame, not measured in this one
+    aim_on_target: bool | None = None  # the laser's aim point shows the target itself (None: not measured)
 
     @property
     def error_x(self) -> float:
@@ -72,6 +73,10 @@ class CandidateSource(Protocol):
     name: str
 
     def candidates(self, image: MatLike) -> list[Candidate]: ...
+
+    def aim_on_target(self, image: MatLike, size: float) -> bool | None:
+        """Whether the frame's centre shows the target's own surface (None: this detector cannot tell)."""
+        ...
 
 
 def focal_px(width: int, horizontal_fov_deg: float) -> float:

@@ -85,6 +85,7 @@ SATURATION = (10.0, 60.0)  # mean saturation above the S bound (pink and pale re
 HUE_OFF = (0.6, 1.0)  # mean hue's distance from the range's middle, in half-widths
 RING = (0.35, 0.1)  # share of the ring of the target's colour (falling ramp)
 SIZE = (8.0, 16.0)  # diameter, pixels: a smaller blob has too few pixels to show its shape
+AIM_SPAN, AIM_SHARE = 0.35, 0.8  # the aim point's window (of the ball's diameter), and its share of target colour
 
 
 Bounds = list[tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]]  # inRange's lower and upper HSV triples
@@ -398,3 +399,13 @@ class HsvBlobDetector:
     def detect(self, image: MatLike) -> Detection:
         """This frame alone, the best candidate (no tracking, no frame checks)."""
         return best_detection(self, image, self.cfg.target_diameter_m, self.fov_deg)
+
+    def aim_on_target(self, image: MatLike, size: float) -> bool:
+        """Whether the laser's aim point (the frame's centre) shows the target's colour, in a window a third of
+        the ball across: something in front of a centred ball hides its middle while the circle fitted to its
+        rim stays centred, and it reaches the window's edge a frame or two before the middle."""
+        h, w = image.shape[:2]
+        r = max(2, min(round(AIM_SPAN * size / 2.0), h // 4))
+        roi = image[h // 2 - r: h // 2 + r + 1, w // 2 - r: w // 2 + r + 1]
+        mask = self._raw_mask(np.ascontiguousarray(roi), self._bounds(self._exposure(image)))
+        return cv2.countNonZero(mask) >= AIM_SHARE * mask.size

@@ -207,3 +207,17 @@ def test_one_inrange_on_the_mirrored_hue_equals_one_inrange_per_range() -> None:
         assert np.count_nonzero(differ) <= 0.01 * differ.size
     general = HsvBlobDetector(HsvConfig(ranges=(((0, 120, 70), (8, 255, 255)), ((172, 100, 70), (179, 255, 255)))))
     assert not general.single_range  # different S bounds: one inRange per range
+
+
+def test_the_aim_point_must_show_the_ball_not_what_is_in_front_of_it() -> None:
+    det = HsvBlobDetector()
+    frame = synth.red_disc(synth.background(320, 240), 160, 120, 25)
+    assert det.aim_on_target(frame, 50.0)
+    edge = frame.copy()
+    cv2.circle(edge, (160 - 60, 120), 40, (200, 80, 20), -1)  # a blue ball over the left of the rim only
+    assert det.detect(edge).found and det.aim_on_target(edge, 50.0)
+    front = frame.copy()
+    cv2.circle(front, (160 - 35, 120), 40, (200, 80, 20), -1)  # ... over the middle: the rim still fits a circle
+    assert not det.aim_on_target(front, 50.0)
+    assert not det.aim_on_target(synth.background(320, 240), 50.0)
+    assert ArucoMarkerDetector().aim_on_target(frame, 50.0) is None  # cannot tell: never blocks on its own

@@ -3,6 +3,7 @@ range while the laser is on."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import drone_protocol as dp
@@ -87,3 +88,17 @@ def test_a_target_drifting_out_of_range_switches_the_laser_off() -> None:
     assert st(c) is State.AIM
     assert frame == dp.laser_off()
     assert c.transitions[-1].reason == "out of range while firing"
+
+
+def test_something_in_front_of_the_target_switches_the_laser_off_and_holds_the_fire() -> None:
+    c, rig = to_state(State.FIRE)
+    assert c.laser_on is True
+    blocked = dataclasses.replace(seen(size=0.3), aim_on_target=False)
+    assert rig.tick(blocked) == dp.laser_off()
+    assert st(c) is State.AIM and c.transitions[-1].reason == "something in front of the target while firing"
+    for _ in range(40):  # centred and confirmed, but the ray would hit the thing in front
+        assert name(rig.tick(blocked)) != "laser_on"
+    assert st(c) is State.AIM
+    for _ in range(10):
+        rig.tick(dataclasses.replace(seen(size=0.3), aim_on_target=True))
+    assert st(c) is State.FIRE
