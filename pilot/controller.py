@@ -60,7 +60,7 @@ import drone_protocol as dp
 
 from .approach import ClosingSpeed, Lean, Momentum, allowed_speed
 from .config import ControllerConfig
-from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, speed_for
+from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, speed_for, turn_towards
 from .detection import Detection
 from .gating import Gate
 from .response import TurnResponse, turn_sense
@@ -302,10 +302,7 @@ class Controller(ControllerCore):
             if closing > allowed + 0.15:  # braking comes before any other correction
                 return self._brake(closing - allowed, det)
         if abs(ex) > cfg.dead_band_x:
-            frac = 0.35 + 0.65 * min(1.0, abs(ex) / 0.5)
-            if ex > 0:
-                return self._emit(dp.turn_right(speed_for(dp.CommandName.TURN_RIGHT, frac)))
-            return self._emit(dp.turn_left(speed_for(dp.CommandName.TURN_LEFT, frac)))
+            return self._emit(turn_towards(ex))
         if abs(ey) > cfg.dead_band_y and not self.seen_from.barred(ey < 0, self.height.settles_m, ey):
             frac = 0.5 + 0.5 * min(1.0, abs(ey) / 0.6)
             if ey < 0:

@@ -57,6 +57,14 @@ def speed_for(command: dp.CommandName, fraction: float) -> int:
     return max(spec.minimum, min(spec.maximum, value))
 
 
+def turn_towards(error_x: float) -> bytes:
+    """A turn towards a horizontal error (-1 .. +1 of the half-width): gentle near the middle, full from half-way."""
+    frac = 0.35 + 0.65 * min(1.0, abs(error_x) / 0.5)
+    if error_x > 0:
+        return dp.turn_right(speed_for(dp.CommandName.TURN_RIGHT, frac))
+    return dp.turn_left(speed_for(dp.CommandName.TURN_LEFT, frac))
+
+
 class ControllerCore:
     def __init__(
         self,
@@ -215,10 +223,13 @@ class ControllerCore:
     def _tan_v(self, det: Detection) -> float:
         return self._tan_h * (det.height / det.width) if det.width else self._tan_h
 
+    def _bearing(self, det: Detection) -> float:
+        """The target's bearing from the body's axis, degrees right (the camera's pan included)."""
+        return self._pan_offset + math.degrees(math.atan(det.error_x * self._tan_h))
+
     def _remember_side(self, det: Detection) -> None:
-        """Which way to sweep if the target is lost: its bearing from the body (camera pan included)."""
-        bearing = self._pan_offset + math.degrees(math.atan(det.error_x * self._tan_h))
-        self._search_sign = 1 if bearing >= 0 else -1
+        """Which way to sweep if the target is lost: its bearing from the body."""
+        self._search_sign = 1 if self._bearing(det) >= 0 else -1
 
     def _servo_correction(self, det: Detection) -> bytes | None:
         """One pan or tilt step towards the target, the larger error first; None when centred."""
@@ -244,15 +255,9 @@ class ControllerCore:
     def _turn_to_camera(self, det: Detection) -> bytes | None:
         """With the camera panned, the turn that brings the body round to the target until a servo reset would
         leave it within ``RESET_ERROR`` of the frame's middle (None: reset now)."""
-        bearing = self._pan_offset + math.degrees(math.atan(det.error_x * self._tan_h))  # from the body's axis
-        bearing = max(-80.0, min(80.0, bearing))  # (the servo's own limit is nearer; past 90° tan turns round)
+        bearing = max(-80.0, min(80.0, self._bearing(det)))  # (the servo's own limit is nearer; past 90° tan turns)
         after = math.tan(math.radians(bearing)) / self._tan_h  # the horizontal error a reset would leave
-        if abs(after) <= RESET_ERROR:
-            return None
-        frac = 0.35 + 0.65 * min(1.0, abs(after) / 0.5)
-        if after > 0:
-            return dp.turn_right(speed_for(dp.CommandName.TURN_RIGHT, frac))
-        return dp.turn_left(speed_for(dp.CommandName.TURN_LEFT, frac))
+        return None if abs(after) <= RESET_ERROR else turn_towards(after)
 
     def _on_idle(self, det: Detection | None) -> bytes | None:
         return None
