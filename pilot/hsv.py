@@ -4,11 +4,8 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
 ``inRange`` on the frame):
 
 1. Search: the frame at half resolution (from 320 px wide up; a 16 px target is still 8 px there),
-   one ``cvtColor``, one ``inRange``, a 3x3 opening, external contours. Red wraps around hue 0, which would
-   need two ranges; converting the BGR frame as if it were RGB mirrors the hue circle (h -> 120 - h, in
-   OpenCV's 0..179 units) and puts red at 120, in one piece. The value (V) bound follows the frame's exposure:
-   in a frame whose brightest pixels are dim, it drops in proportion (never below ``V_FLOOR``), so that a
-   ball's shaded side stays in the mask and the fitted circle stays on the ball.
+   one ``cvtColor``, one ``inRange``, a 3x3 opening, external contours. The ranges as the fewest ``inRange``
+   calls (red in one piece) and the V bound that follows the frame's exposure are ``pilot.hsv_colour``.
 2. Refine: the few largest blobs filling at least ``SEARCH_FILL`` of their box's disc are looked at again at
    full resolution, in a window around each: a 3x3 median (sensor noise in a ball's shaded side would fray
    its outline), mask, 3x3 opening and closing, the blob's contours, and a score 0..1 each, a product of
@@ -48,12 +45,11 @@ from typing import NamedTuple
 
 import cv2
 import numpy as np
-import numpy.typing as npt
 from cv2.typing import MatLike
 
 from .config import HsvConfig, VisionConfig
 from .detection import Candidate, Detection, best_detection, frame_size, range_of
-from .errors import ConfigError
+from .hsv_colour import Bounds, ColourMask
 from .hsv_shape import ELLIPSE_ASPECT, RING_POINTS, ellipse_support, outer_rim, share_set
 from .hsv_split import disc_centres, hue_split, round_pieces, split_off
 
@@ -62,8 +58,6 @@ SEARCH_FILL = 0.45  # below FILL's zero: the search's coarser outline never reje
 BLOBS_PER_BOX = 2  # blobs measured in one search blob's window (noise can join two at half resolution)
 SEARCH_MIN_WIDTH = 320  # frames at least this wide are searched at half resolution
 HALF_MEASURE = 48  # px across (full resolution): a search blob this wide is measured at half resolution
-V_REFERENCE = 200.0  # brightness (see _exposure) of a well-exposed frame; the V bound scales below it
-V_FLOOR = 24  # the V bound never drops below this: under it hue and saturation are noise
 SPLIT_FILL = 0.75  # a search blob filling less of its box's disc may be a ball joined to something
 SPLIT_BLOBS = 3  # the largest such blobs searched for discs
 SPLIT_PEAKS = 4  # disc centres refined per frame, widest first
@@ -88,7 +82,6 @@ SIZE = (8.0, 16.0)  # diameter, pixels: a smaller blob has too few pixels to sho
 AIM_SPAN, AIM_SHARE = 0.35, 0.8  # the aim point's window (of the ball's diameter), and its share of target colour
 
 
-Bounds = list[tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]]  # inRange's lower and upper HSV triples
 Box = tuple[int, int, int, int]  # x, y, width, height
 
 
@@ -121,11 +114,6 @@ def _new(f: Features, found: list[Features]) -> bool:
     return all(abs(f.cx - g.cx) > 1.0 or abs(f.cy - g.cy) > 1.0 for g in found)
 
 
-def _contiguous(hues: set[int]) -> tuple[int, int] | None:
-    lo, hi = min(hues), max(hues)
-    return (lo, hi) if hi - lo + 1 == len(hues) else None
-
-
 class HsvBlobDetector:
     name = "hsv"
 
@@ -133,91 +121,33 @@ class HsvBlobDetector:
         self, config: HsvConfig | None = None, vision: VisionConfig | None = None, fov_deg: float = 60.0
     ) -> None:
         cfg = config or HsvConfig()
-        if not cfg.ranges:
-            raise ConfigError("hsv.ranges: at least one range is needed")
+        self.colour = ColourMask(cfg)  # raises ConfigError without a range
         self.cfg = cfg
         self.vision = vision or VisionConfig()
         self.fov_deg = fov_deg
-        hues = {h for lo, hi in cfg.ranges for h in range(lo[0], hi[0] + 1)}
-        sv = {(lo[1:], hi[1:]) for lo, hi in cfg.ranges}
-        mirrored = {(120 - h) % 180 for h in hues}
-        self._code = cv2.COLOR_BGR2HSV
-        ranges = [(np.array(lo, np.uint8), np.array(hi, np.uint8)) for lo, hi in cfg.ranges]
-        span = _contiguous(hues)
-        if span is None and _contiguous(mirrored) is not None:
-            span, self._code = _contiguous(mirrored), cv2.COLOR_RGB2HSV
-            # each range mirrored too (a range holding hue 120 is not in one piece mirrored: the union then is not)
-            ranges = [(np.array(((120 - hi[0]) % 180, *lo[1:]), np.uint8),
-                       np.array(((120 - lo[0]) % 180, *hi[1:]), np.uint8)) for lo, hi in cfg.ranges]
-        if span is not None and len(sv) == 1:
-            ((s_lo, v_lo), (s_hi, v_hi)), = sv
-            ranges = [(np.array((span[0], s_lo, v_lo), np.uint8), np.array((span[1], s_hi, v_hi), np.uint8))]
-        self._ranges = ranges
-        # colour purity refers to the hue range's middle and half-width (in the space the mask uses)
-        used = hues if self._code == cv2.COLOR_BGR2HSV else mirrored
-        self._hue_mid = (min(used) + max(used)) / 2.0
-        self._hue_half = max(1.0, (max(used) - min(used)) / 2.0)
         self._width = 320  # of the frame being looked at (range estimates)
-        self._sat_lo = float(min(lo[1] for lo, _ in cfg.ranges))
-        k = max(1, cfg.open_kernel)
-        self._kernel = cv2.getStructuringElement(cv2.MORPH_RECT, (k, k)) if k > 1 else None
 
     @property
     def single_range(self) -> bool:
         """True when the mask costs one cvtColor and one inRange (contiguous hues, shared S/V bounds)."""
-        return len(self._ranges) == 1
-
-    # -- masks --------------------------------------------------------------------------------------
-    def _exposure(self, image: MatLike) -> float:
-        """The frame's brightness: a high order statistic of every channel on a sparse grid (a few µs)."""
-        step = max(4, image.shape[1] // 24)  # about 24x18 samples at any frame size
-        grid = np.asarray(image[::step, ::step]).reshape(-1)
-        k = max(1, grid.size // 50)  # the 98th percentile, without a sort
-        return float(np.partition(grid, grid.size - k)[grid.size - k])
-
-    def _bounds(self, exposure: float) -> Bounds:
-        gain = min(1.0, exposure / V_REFERENCE)
-        if gain >= 1.0:
-            return self._ranges
-        out = []
-        for lo, hi in self._ranges:
-            adapted = lo.copy()
-            adapted[2] = max(min(int(lo[2]), V_FLOOR), round(int(lo[2]) * gain))
-            out.append((adapted, hi))
-        return out
-
-    def _raw_mask(self, image: MatLike, bounds: Bounds) -> MatLike:
-        return self._in_range(cv2.cvtColor(image, self._code), bounds)
-
-    @staticmethod
-    def _in_range(hsv: MatLike, bounds: Bounds) -> MatLike:
-        mask = cv2.inRange(hsv, bounds[0][0], bounds[0][1])
-        for lo, hi in bounds[1:]:
-            mask = cv2.bitwise_or(mask, cv2.inRange(hsv, lo, hi))
-        return mask
-
-    def _clean(self, mask: MatLike) -> MatLike:
-        if self._kernel is None:
-            return mask
-        # opening: speckle goes; closing: a noisy target's pinholes and ragged rim are mended
-        return cv2.morphologyEx(cv2.morphologyEx(mask, cv2.MORPH_OPEN, self._kernel), cv2.MORPH_CLOSE, self._kernel)
+        return self.colour.single_range
 
     def mask(self, image: MatLike) -> MatLike:
         """The full-resolution mask (with the exposure-adapted V bound), as the refinement sees it."""
-        return self._clean(self._raw_mask(image, self._bounds(self._exposure(image))))
+        return self.colour.mask(image)
 
     # -- candidates ---------------------------------------------------------------------------------
     def features(self, image: MatLike) -> list[Features]:
         """Every refined blob's features (unscored)."""
         w, h = frame_size(image)
         self._width = w
-        bounds = self._bounds(self._exposure(image))
+        bounds = self.colour.bounds_for(image)
         scale = 2 if w >= SEARCH_MIN_WIDTH else 1
         small = cv2.resize(image, (w // scale, h // scale), interpolation=cv2.INTER_AREA) if scale > 1 else image
-        small_hsv = cv2.cvtColor(small, self._code)
-        mask = self._in_range(small_hsv, bounds)
-        if self._kernel is not None:
-            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, self._kernel)
+        small_hsv = cv2.cvtColor(small, self.colour.code)
+        mask = self.colour.in_range(small_hsv, bounds)
+        if self.colour.kernel is not None:
+            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, self.colour.kernel)
         # every point kept: a blob measured on the search needs them for its arcs
         contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
         min_area = self.cfg.min_area / (scale * scale)
@@ -272,7 +202,7 @@ class HsvBlobDetector:
             for h0, h1 in ((int(lo[0]), t), (t + 1, int(hi[0]))):
                 sub_lo, sub_hi = lo.copy(), hi.copy()
                 sub_lo[0], sub_hi[0] = h0, h1
-                sub = self._clean(cv2.bitwise_and(cv2.inRange(window, sub_lo, sub_hi), blob))
+                sub = self.colour.clean(cv2.bitwise_and(cv2.inRange(window, sub_lo, sub_hi), blob))
                 for _, (px, py, pw, ph) in round_pieces(sub, min_area, SEARCH_FILL)[:HUE_PIECES]:
                     box = ((px + x) * scale, (py + y) * scale, pw * scale, ph * scale)
                     out += [f for f in self._refine(image, [(sub_lo, sub_hi)], box) if _new(f, found + out)]
@@ -294,8 +224,8 @@ class HsvBlobDetector:
         """The window's HSV and cleaned mask."""
         # smoothed: sensor noise in a ball's shaded side would fray its outline and the shape with it
         roi = cv2.medianBlur(np.ascontiguousarray(image[y0:y1, x0:x1]), 3)
-        hsv = cv2.cvtColor(roi, self._code)
-        return hsv, self._clean(self._in_range(hsv, bounds))
+        hsv = cv2.cvtColor(roi, self.colour.code)
+        return hsv, self.colour.clean(self.colour.in_range(hsv, bounds))
 
     def _refine(self, image: MatLike, bounds: Bounds, box: Box) -> list[Features]:
         """The blobs of a search box at full resolution (a search blob may be several joined by noise), in a
@@ -370,7 +300,7 @@ class HsvBlobDetector:
         half = (scale - 1) / 2.0  # a pixel's centre at half resolution lies between two at full resolution
         return Features(
             (cx + x0) * scale + half, (cy + y0) * scale + half, size, arc, solidity, fill, elongation,
-            float(mean[1]), abs(float(mean[0]) - self._hue_mid) / self._hue_half, ring, ellipse_arc,
+            float(mean[1]), abs(float(mean[0]) - self.colour.hue_mid) / self.colour.hue_half, ring, ellipse_arc,
         )
 
     def _size_score(self, size: float, width: int) -> float:
@@ -382,7 +312,7 @@ class HsvBlobDetector:
     def score(self, f: Features, width: int) -> float:
         shape = _arc_score(f.arc, f.ellipse_arc) * _ramp(f.solidity, *SOLIDITY) * _ramp(f.fill, *FILL)
         shape *= _ramp(f.elongation, *ELONGATION) * self._size_score(f.size, width)
-        colour = _ramp(f.saturation, self._sat_lo + SATURATION[0], self._sat_lo + SATURATION[1])
+        colour = _ramp(f.saturation, self.colour.sat_lo + SATURATION[0], self.colour.sat_lo + SATURATION[1])
         colour *= 1.0 - _ramp(f.hue_off, *HUE_OFF)
         return shape * colour * _ramp(f.ring, *RING)
 
@@ -404,8 +334,5 @@ class HsvBlobDetector:
         """Whether the laser's aim point (the frame's centre) shows the target's colour, in a window a third of
         the ball across: something in front of a centred ball hides its middle while the circle fitted to its
         rim stays centred, and it reaches the window's edge a frame or two before the middle."""
-        h, w = image.shape[:2]
-        r = max(2, min(round(AIM_SPAN * size / 2.0), h // 4))
-        roi = image[h // 2 - r: h // 2 + r + 1, w // 2 - r: w // 2 + r + 1]
-        mask = self._raw_mask(np.ascontiguousarray(roi), self._bounds(self._exposure(image)))
-        return cv2.countNonZero(mask) >= AIM_SHARE * mask.size
+        r = max(2, min(round(AIM_SPAN * size / 2.0), image.shape[0] // 4))
+        return self.colour.centre_share(image, r) >= AIM_SHARE
