@@ -33,6 +33,10 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
    bulge out of them, the mask opened by a disc half as wide (necks go, the ball stays whole; its arcs count
    only on the mask's real edge, as an opened square is round); and by hue, when their pixels fall in two hue
    classes (a ball a few units off a red-brown saucer), each class's round pieces refined in its own range.
+4. Edges: a ball on a surface of its colour (a red-brown saucer, a red motorbike's tank) is in one piece with
+   it even in hue; if still nothing scores ``SPLIT_UNLESS``, the largest joined blobs' windows are cut by the
+   image's edges (pilot/hsv_edges.py) and the round pieces from ``hsv_edges.MIN_SIZE`` measured, isolation
+   then being the share of the rim just outside them that is an edge or off the mask.
 
 A search blob from ``HALF_TRY`` px across is first measured on the search itself: a plain disc scoring high
 there, or any blob from ``HALF_MEASURE`` px, skips the refinement and its fixed cost.
@@ -50,6 +54,7 @@ from cv2.typing import MatLike
 from .config import HsvConfig, VisionConfig
 from .detection import Candidate, Detection, best_detection, frame_size, range_of
 from .hsv_colour import Bounds, ColourMask
+from .hsv_edges import MIN_SIZE, WALL_GROWTH, cut_by_edges, walled_in
 from .hsv_shape import ELLIPSE_ASPECT, RING_POINTS, ellipse_support, outer_rim, share_set
 from .hsv_split import disc_centres, hue_split, round_pieces, split_off
 
@@ -62,6 +67,7 @@ SPLIT_FILL = 0.75  # a search blob filling less of its box's disc may be a ball 
 SPLIT_BLOBS = 3  # the largest such blobs searched for discs
 SPLIT_PEAKS = 4  # disc centres refined per frame, widest first
 HUE_PIECES = 2  # the largest round pieces of each hue class refined
+EDGE_BLOBS = 2  # the largest joined blobs cut by the image's edges
 HALF_TRY = 24  # px across: a smaller search blob is only refined
 HALF_DECIDES = 0.9  # the half-resolution score that keeps a blob from the refinement...
 HALF_FILL = 0.8  # ...for a plain disc only: this fill of its circle (a square's is 0.64)...
@@ -97,7 +103,7 @@ class Features(NamedTuple):
     elongation: float
     saturation: float  # mean, 0..255
     hue_off: float  # mean hue's distance from the range's middle, in half-widths
-    ring: float
+    ring: float  # the ring's share of the target's colour (a piece cut by edges: its rim's share not walled in)
     ellipse_arc: float  # 0 where the circle's arc was enough (it is measured only below ARC's one)
 
 
@@ -181,7 +187,33 @@ class HsvBlobDetector:
             found += self._split(image, bounds, joined, scale, found)
             if len(bounds) == 1:
                 found += self._hue_split(image, bounds, small_hsv, mask, joined, scale, found)
+            if not any(self.score(f, w) >= SPLIT_UNLESS for f in found):
+                found += self._edge_split(image, bounds, joined, scale, found)
         return found
+
+    def _edge_split(self, image: MatLike, bounds: Bounds, joined: list[tuple[float, MatLike, Box]],
+                    scale: int, found: list[Features]) -> list[Features]:
+        """Balls on a surface of their colour: the largest joined blobs' windows cut by the image's edges, the
+        round pieces measured alone, their ring replaced by the share of their rim not walled in."""
+        w, h = frame_size(image)
+        out: list[Features] = []
+        for _, _, (x, y, bw, bh) in joined[:EDGE_BLOBS]:
+            if max(bw, bh) * scale < MIN_SIZE:
+                continue
+            x0, y0 = max(0, x * scale - 4), max(0, y * scale - 4)
+            roi, hsv, mask = self._window(image, bounds, x0, y0, min(w, (x + bw) * scale + 4),
+                                          min(h, (y + bh) * scale + 4))
+            cut = cut_by_edges(roi, mask, self.colour.kernel, self.cfg.min_area, SEARCH_FILL)
+            for c, area in cut.pieces:
+                piece = np.zeros_like(np.asarray(mask))
+                cv2.drawContours(piece, [c], -1, 255, -1)
+                f = self._measure(hsv, piece, c, area, x0, y0)
+                if f is None:
+                    continue
+                f = f._replace(size=f.size + WALL_GROWTH, ring=1.0 - walled_in(cut.separated, c))
+                if f.size >= MIN_SIZE and _new(f, found + out):
+                    out.append(f)
+        return out
 
     def _hue_split(self, image: MatLike, bounds: Bounds, hsv: MatLike, mask: MatLike,
                    joined: list[tuple[float, MatLike, Box]], scale: int, found: list[Features]) -> list[Features]:
@@ -220,12 +252,13 @@ class HsvBlobDetector:
                 out.append(f)
         return out
 
-    def _window(self, image: MatLike, bounds: Bounds, x0: int, y0: int, x1: int, y1: int) -> tuple[MatLike, MatLike]:
-        """The window's HSV and cleaned mask."""
+    def _window(self, image: MatLike, bounds: Bounds, x0: int, y0: int, x1: int,
+                y1: int) -> tuple[MatLike, MatLike, MatLike]:
+        """The window's smoothed pixels, their HSV and the cleaned mask."""
         # smoothed: sensor noise in a ball's shaded side would fray its outline and the shape with it
         roi = cv2.medianBlur(np.ascontiguousarray(image[y0:y1, x0:x1]), 3)
         hsv = cv2.cvtColor(roi, self.colour.code)
-        return hsv, self.colour.clean(self.colour.in_range(hsv, bounds))
+        return roi, hsv, self.colour.clean(self.colour.in_range(hsv, bounds))
 
     def _refine(self, image: MatLike, bounds: Bounds, box: Box) -> list[Features]:
         """The blobs of a search box at full resolution (a search blob may be several joined by noise), in a
@@ -234,7 +267,7 @@ class HsvBlobDetector:
         bx, by, bw, bh = box
         pad = max(bw, bh) // 2 + 4  # a ring reaches 1.75 radii; the search rounds by a pixel or two
         x0, y0 = max(0, bx - pad), max(0, by - pad)
-        hsv, mask = self._window(image, bounds, x0, y0, min(w, bx + bw + pad), min(h, by + bh + pad))
+        _, hsv, mask = self._window(image, bounds, x0, y0, min(w, bx + bw + pad), min(h, by + bh + pad))
         contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
         blobs = [(a, c) for c in contours if len(c) >= 8 and (a := float(cv2.contourArea(c))) >= self.cfg.min_area]
         blobs.sort(key=lambda b: b[0], reverse=True)
@@ -247,7 +280,7 @@ class HsvBlobDetector:
         pad = int(2.0 * r) + 6  # the ring reaches 1.75 radii
         cx, cy = int(px), int(py)
         x0, y0 = max(0, cx - pad), max(0, cy - pad)
-        hsv, mask = self._window(image, bounds, x0, y0, min(w, cx + pad + 1), min(h, cy + pad + 1))
+        _, hsv, mask = self._window(image, bounds, x0, y0, min(w, cx + pad + 1), min(h, cy + pad + 1))
         piece = split_off(mask, cx - x0, cy - y0, r, self.cfg.min_area)
         if piece is None:
             return None
