@@ -34,7 +34,7 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
    only on the mask's real edge, as an opened square is round); and by hue, when their pixels fall in two hue
    classes (a ball a few units off a red-brown saucer), each class's round pieces refined in its own range.
 4. Edges: a ball on a surface of its colour (a red-brown saucer, a red motorbike's tank) is in one piece with
-   it even in hue; if still nothing scores ``SPLIT_UNLESS``, the largest joined blobs' windows are cut by the
+   it even in hue; if still nothing scores ``SPLIT_UNLESS``, the largest search blobs' windows are cut by the
    image's edges (pilot/hsv_edges.py) and the round pieces from ``hsv_edges.MIN_SIZE`` measured, isolation
    then being the share of the rim just outside them that is an edge or off the mask.
 
@@ -67,7 +67,7 @@ SPLIT_FILL = 0.75  # a search blob filling less of its box's disc may be a ball 
 SPLIT_BLOBS = 3  # the largest such blobs searched for discs
 SPLIT_PEAKS = 4  # disc centres refined per frame, widest first
 HUE_PIECES = 2  # the largest round pieces of each hue class refined
-EDGE_BLOBS = 2  # the largest joined blobs cut by the image's edges
+EDGE_BLOBS = 2  # the largest search blobs cut by the image's edges
 HALF_TRY = 24  # px across: a smaller search blob is only refined
 HALF_DECIDES = 0.9  # the half-resolution score that keeps a blob from the refinement...
 HALF_FILL = 0.8  # ...for a plain disc only: this fill of its circle (a square's is 0.64)...
@@ -159,11 +159,13 @@ class HsvBlobDetector:
         min_area = self.cfg.min_area / (scale * scale)
         boxes: list[tuple[float, MatLike, Box]] = []
         joined: list[tuple[float, MatLike, Box]] = []
+        blobs: list[tuple[float, MatLike, Box]] = []
         for c in contours:
             if len(c) < 6 or (area := cv2.contourArea(c)) < min_area:
                 continue
             x, y, bw, bh = cv2.boundingRect(c)
             box = (x, y, bw, bh)
+            blobs.append((area, c, box))
             disc = math.pi * (max(bw, bh) / 2.0) ** 2
             # a blob filling less than SEARCH_FILL of its box's disc cannot hold a ball the refinement would take
             if area >= SEARCH_FILL * disc:
@@ -187,17 +189,19 @@ class HsvBlobDetector:
             found += self._split(image, bounds, joined, scale, found)
             if len(bounds) == 1:
                 found += self._hue_split(image, bounds, small_hsv, mask, joined, scale, found)
-            if not any(self.score(f, w) >= SPLIT_UNLESS for f in found):
-                found += self._edge_split(image, bounds, joined, scale, found)
+        if blobs and not any(self.score(f, w) >= SPLIT_UNLESS for f in found):
+            # any blob: a ball with a stub of a saucer on it can fill its box like a ball, and score too low
+            blobs.sort(key=lambda b: b[0], reverse=True)
+            found += self._edge_split(image, bounds, blobs, scale, found)
         return found
 
-    def _edge_split(self, image: MatLike, bounds: Bounds, joined: list[tuple[float, MatLike, Box]],
+    def _edge_split(self, image: MatLike, bounds: Bounds, blobs: list[tuple[float, MatLike, Box]],
                     scale: int, found: list[Features]) -> list[Features]:
-        """Balls on a surface of their colour: the largest joined blobs' windows cut by the image's edges, the
+        """Balls on a surface of their colour: the largest search blobs' windows cut by the image's edges, the
         round pieces measured alone, their ring replaced by the share of their rim not walled in."""
         w, h = frame_size(image)
         out: list[Features] = []
-        for _, _, (x, y, bw, bh) in joined[:EDGE_BLOBS]:
+        for _, _, (x, y, bw, bh) in blobs[:EDGE_BLOBS]:
             if max(bw, bh) * scale < MIN_SIZE:
                 continue
             x0, y0 = max(0, x * scale - 4), max(0, y * scale - 4)
