@@ -265,11 +265,18 @@ class Controller(ControllerCore):
             if self._hits >= self.cfg.acquire_frames:
                 self._go(State.TRACK, f"seen in {self._hits} consecutive frames")
                 return self._on_track(det)
-            return self._emit(dp.hold_altitude())
+            return self._hold(det)
         self._hits = 0  # the sightings must be consecutive
         self._misses += 1
         if self._misses >= self.cfg.lost_frames:  # hovering, a flickering far target gets a few chances
             self._go(State.SEARCH, "sighting not confirmed")
+        return self._hold(det)
+
+    def _hold(self, det: Detection | None) -> bytes | None:
+        """Sticks neutral while a sighting is confirmed, unless the brake planned at a loss is not over: a target
+        seen again at once (half covered, flickering) would otherwise let the drone coast on into what covers it."""
+        if self._now() < self._brake_until_ms:
+            return self._brake(self._brake_speed, det)
         return self._emit(dp.hold_altitude())
 
     def _on_track(self, det: Detection | None) -> bytes | None:

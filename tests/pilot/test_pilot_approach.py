@@ -78,6 +78,27 @@ def test_lost_while_closing_brakes_before_the_search_turns() -> None:
     assert dp.COMMANDS[dp.CommandName.MOVE_BACKWARD].target == "pitch"
 
 
+def test_a_sighting_while_braking_at_a_loss_does_not_end_the_brake() -> None:
+    """A half-covered target flickers: lost while closing in, then seen every other frame, never confirmed.
+    Confirming a sighting goes on with the brake planned at the loss (neutral sticks would coast the drone into
+    the cover), for that brake's time and no longer."""
+    c, rig = to_state(State.TRACK)
+    r = 3.0
+    for _ in range(6):
+        r -= 0.04  # 0.8 m/s closer
+        rig.tick(seen(size=size_at(r)))
+    while st(c) is not State.SEARCH:
+        rig.tick(MISS)
+    outs, states = [], set()
+    for k in range(60):
+        outs.append(name(rig.tick(seen(size=size_at(r)) if k % 2 else MISS)))
+        states.add(st(c))
+    assert State.ACQUIRE in states  # the sightings were taken up
+    brakes = outs.index(next(o for o in outs if o != "move_backward"))
+    assert brakes * 50 >= 800, outs  # about 0.8 m/s at the brake's deceleration, plus the lean's lag
+    assert "move_backward" not in outs[brakes:], outs  # then hovering and sweeping, no brake held on
+
+
 def test_a_target_that_stops_shrinking_before_it_is_lost_still_gets_its_brake() -> None:
     """Going out of sight, a target's last frames can read a constant range (covered or clipped, it looks
     smaller than it is): the brake at the loss follows the last 1.2 s of ranges, not only the last 0.4 s."""
