@@ -108,7 +108,8 @@ class Features(NamedTuple):
 
 
 def _ramp(value: float, zero: float, one: float) -> float:
-    return min(1.0, max(0.0, (value - zero) / (one - zero)))
+    v = (value - zero) / (one - zero)  # compared, not clamped with min/max: about 40 calls a frame
+    return 0.0 if v <= 0.0 else 1.0 if v >= 1.0 else v
 
 
 def _arc_score(arc: float, ellipse_arc: float) -> float:
@@ -184,12 +185,15 @@ class HsvBlobDetector:
             else:
                 fs = self._refine(image, bounds, (x * scale, y * scale, bw * scale, bh * scale))
             found += [f for f in fs if _new(f, found)]
-        if joined and not any(self.score(f, w) >= SPLIT_UNLESS for f in found):
+        good = any(self.score(f, w) >= SPLIT_UNLESS for f in found)
+        if joined and not good:
             joined.sort(key=lambda b: b[0], reverse=True)
-            found += self._split(image, bounds, joined, scale, found)
+            split = self._split(image, bounds, joined, scale, found)
             if len(bounds) == 1:
-                found += self._hue_split(image, bounds, small_hsv, mask, joined, scale, found)
-        if blobs and not any(self.score(f, w) >= SPLIT_UNLESS for f in found):
+                split += self._hue_split(image, bounds, small_hsv, mask, joined, scale, found + split)
+            found += split
+            good = any(self.score(f, w) >= SPLIT_UNLESS for f in split)
+        if blobs and not good:
             # any blob: a ball with a stub of a saucer on it can fill its box like a ball, and score too low
             blobs.sort(key=lambda b: b[0], reverse=True)
             found += self._edge_split(image, bounds, blobs, scale, found)
