@@ -38,6 +38,11 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
    image's edges (pilot/hsv_edges.py) and the round pieces from ``hsv_edges.MIN_SIZE`` measured, isolation
    then being the share of the rim just outside them that is an edge or off the mask.
 
+A frame where nothing scores ``SECOND_LOOK_UNLESS`` gets a second look, steps 1 and 2 with the V bound 0.8 times as
+high, keeping what scores ``SECOND_LOOK_MIN``: a ball's shaded side, or a ball in dim or back light, falls below
+the bound (a lower bound for every frame joined dark red-brown surfaces to the balls on the tuning photos; the
+splits again would cost the frames without a target 0.1x the floor in the median, for a few balls more).
+
 A search blob from ``HALF_TRY`` px across is first measured on the search itself: a plain disc scoring high
 there, or any blob from ``HALF_MEASURE`` px, skips the refinement and its fixed cost.
 """
@@ -53,7 +58,7 @@ from cv2.typing import MatLike
 
 from .config import HsvConfig, VisionConfig
 from .detection import Candidate, Detection, best_detection, frame_size, range_of
-from .hsv_colour import Bounds, ColourMask
+from .hsv_colour import Bounds, ColourMask, darker
 from .hsv_edges import MIN_SIZE, WALL_GROWTH, cut_by_edges, walled_in
 from .hsv_shape import ELLIPSE_ASPECT, RING_POINTS, ellipse_support, outer_rim, share_set
 from .hsv_split import disc_centres, hue_split, round_pieces, split_off
@@ -73,6 +78,9 @@ HALF_DECIDES = 0.9  # the half-resolution score that keeps a blob from the refin
 HALF_FILL = 0.8  # ...for a plain disc only: this fill of its circle (a square's is 0.64)...
 HALF_ARC = 0.8  # ...and this share of its outline on it
 SPLIT_UNLESS = 0.8  # a candidate scoring this already: no split (0.1-0.3 ms a disc or piece refined)
+SECOND_LOOK_UNLESS = 0.6  # nothing scoring this (the default acquisition threshold): a second look...
+SECOND_LOOK_GAIN = 0.8  # ...with the V bound this much lower (a ball's shaded side, a dim or backlit ball)...
+SECOND_LOOK_MIN = 0.75  # ...keeps what scores this: a fallback needs stronger evidence (tuning photos' empty views)
 RIM_STEP = 2.0  # px outwards from a contour point where the unopened mask must be unset for a real edge
 # score ramps (zero, one), set on the tuning photos only (bench/vision/RESULTS.md)
 ARC = (0.3, 0.6)
@@ -145,13 +153,26 @@ class HsvBlobDetector:
 
     # -- candidates ---------------------------------------------------------------------------------
     def features(self, image: MatLike) -> list[Features]:
-        """Every refined blob's features (unscored)."""
+        """Every refined blob's features (unscored): a second look with a lower V bound when the first found
+        nothing scoring ``SECOND_LOOK_UNLESS``."""
         w, h = frame_size(image)
         self._width = w
         bounds = self.colour.bounds_for(image)
         scale = 2 if w >= SEARCH_MIN_WIDTH else 1
         small = cv2.resize(image, (w // scale, h // scale), interpolation=cv2.INTER_AREA) if scale > 1 else image
         small_hsv = cv2.cvtColor(small, self.colour.code)
+        found = self._look(image, bounds, small_hsv, scale)
+        lower = darker(bounds, SECOND_LOOK_GAIN)
+        lowered = any(int(a[0][2]) != int(b[0][2]) for a, b in zip(lower, bounds, strict=True))  # not at the floor
+        if lowered and not any(self.score(f, w) >= SECOND_LOOK_UNLESS for f in found):
+            more = self._look(image, lower, small_hsv, scale, splits=False)
+            found += [f for f in more if _new(f, found) and self.score(f, w) >= SECOND_LOOK_MIN]
+        return found
+
+    def _look(self, image: MatLike, bounds: Bounds, small_hsv: MatLike, scale: int, splits: bool = True,
+              ) -> list[Features]:
+        """Steps 1 to 4 (without ``splits``, 1 and 2) with ``bounds``, on the search's HSV (``scale`` x smaller)."""
+        w = frame_size(image)[0]
         mask = self.colour.in_range(small_hsv, bounds)
         if self.colour.kernel is not None:
             mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, self.colour.kernel)
@@ -185,7 +206,7 @@ class HsvBlobDetector:
             else:
                 fs = self._refine(image, bounds, (x * scale, y * scale, bw * scale, bh * scale))
             found += [f for f in fs if _new(f, found)]
-        good = any(self.score(f, w) >= SPLIT_UNLESS for f in found)
+        good = not splits or any(self.score(f, w) >= SPLIT_UNLESS for f in found)
         if joined and not good:
             joined.sort(key=lambda b: b[0], reverse=True)
             split = self._split(image, bounds, joined, scale, found)

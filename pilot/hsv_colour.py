@@ -28,6 +28,16 @@ def _contiguous(hues: set[int]) -> tuple[int, int] | None:
     return (lo, hi) if hi - lo + 1 == len(hues) else None
 
 
+def darker(bounds: Bounds, gain: float) -> Bounds:
+    """The bounds with their V bound scaled by ``gain`` (never below ``V_FLOOR``, nor raised by it)."""
+    out = []
+    for lo, hi in bounds:
+        adapted = lo.copy()
+        adapted[2] = max(min(int(lo[2]), V_FLOOR), round(int(lo[2]) * gain))
+        out.append((adapted, hi))
+    return out
+
+
 class ColourMask:
     def __init__(self, cfg: HsvConfig) -> None:
         if not cfg.ranges:
@@ -67,14 +77,7 @@ class ColourMask:
         grid = np.asarray(image[::step, ::step]).reshape(-1)
         k = max(1, grid.size // 50)  # the 98th percentile, without a sort
         gain = min(1.0, float(np.partition(grid, grid.size - k)[grid.size - k]) / V_REFERENCE)
-        if gain >= 1.0:
-            return self.ranges
-        out = []
-        for lo, hi in self.ranges:
-            adapted = lo.copy()
-            adapted[2] = max(min(int(lo[2]), V_FLOOR), round(int(lo[2]) * gain))
-            out.append((adapted, hi))
-        return out
+        return self.ranges if gain >= 1.0 else darker(self.ranges, gain)
 
     def raw(self, image: MatLike, bounds: Bounds) -> MatLike:
         return self.in_range(cv2.cvtColor(image, self.code), bounds)

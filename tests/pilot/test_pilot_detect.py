@@ -7,6 +7,7 @@ import numpy as np
 import pilot_synth as synth
 import pytest
 
+from pilot import hsv
 from pilot.config import ArucoConfig, HsvConfig
 from pilot.detect import ArucoMarkerDetector, HsvBlobDetector
 
@@ -93,6 +94,19 @@ def test_hsv_ball_on_a_surface_of_its_colour_is_cut_free_by_its_edges(cx: int, c
     d = HsvBlobDetector(HsvConfig()).detect(synth.red_disc(saucer, cx, cy, r, noise=3.0))
     assert d.found and d.confidence >= 0.6, d
     assert abs(d.cx - cx) <= 1.5 and abs(d.cy - cy) <= 1.5 and abs(d.size - (2 * r + 1)) <= 3.0, d
+
+
+def test_hsv_dark_ball_gets_a_second_look(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A ball a little darker than the mask's V bound (a bright window elsewhere keeps the exposure's bound up) is
+    not in the first look's mask; the second look, with the bound lower, finds it."""
+    img = synth.background(320, 240)
+    img[:40, :60] = 250  # the bright window
+    dark = cv2.cvtColor(np.array([[[0, 210, 62]]], np.uint8), cv2.COLOR_HSV2BGR)[0, 0]  # V 62, below 70
+    cv2.circle(img, (170, 130), 22, tuple(int(v) for v in dark), -1, cv2.LINE_AA)
+    d = HsvBlobDetector(HsvConfig()).detect(img)
+    assert d.found and d.confidence >= 0.6 and abs(d.cx - 170) <= 1.5 and abs(d.cy - 130) <= 1.5, d
+    monkeypatch.setattr(hsv, "SECOND_LOOK_GAIN", 1.0)  # no lower bound: no second look
+    assert not HsvBlobDetector(HsvConfig()).detect(img).found
 
 
 def test_hsv_red_surface_cut_by_its_texture_is_no_ball() -> None:
