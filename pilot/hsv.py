@@ -40,8 +40,8 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
 
 A frame where nothing scores ``SECOND_LOOK_UNLESS`` gets a second look, steps 1 and 2 with the V bound 0.8 times as
 high, keeping what scores ``SECOND_LOOK_MIN``: a ball's shaded side, or a ball in dim or back light, falls below
-the bound (a lower bound for every frame joined dark red-brown surfaces to the balls on the tuning photos; the
-splits again would cost the frames without a target 0.1x the floor in the median, for a few balls more).
+the bound (a lower bound for every frame joined dark red-brown surfaces to the balls on the tuning photos; steps 3
+and 4 in it too found a few balls more for 0.15x the floor more in bench/vision's median).
 
 A search blob from ``HALF_TRY`` px across is first measured on the search itself: a plain disc scoring high
 there, or any blob from ``HALF_MEASURE`` px, skips the refinement and its fixed cost.
@@ -169,8 +169,8 @@ class HsvBlobDetector:
             found += [f for f in more if _new(f, found) and self.score(f, w) >= SECOND_LOOK_MIN]
         return found
 
-    def _look(self, image: MatLike, bounds: Bounds, small_hsv: MatLike, scale: int, splits: bool = True,
-              ) -> list[Features]:
+    def _look(self, image: MatLike, bounds: Bounds, small_hsv: MatLike, scale: int,
+              splits: bool = True) -> list[Features]:
         """Steps 1 to 4 (without ``splits``, 1 and 2) with ``bounds``, on the search's HSV (``scale`` x smaller)."""
         w = frame_size(image)[0]
         mask = self.colour.in_range(small_hsv, bounds)
