@@ -8,10 +8,10 @@ import math
 
 import drone_protocol as dp
 import pytest
-from controller_rig import CFG, MISS, name, seen, st, to_state
+from controller_rig import CFG, MISS, Rig, name, seen, st, to_state
 
 from pilot.approach import ClosingSpeed, Lean, allowed_speed
-from pilot.controller import MIN_BRAKE, State
+from pilot.controller import MIN_BRAKE, Controller, State
 from pilot.detection import range_of
 
 W = 320
@@ -64,7 +64,8 @@ def test_track_coasts_or_brakes_when_closing_faster_than_it_can_stop() -> None:
     assert st(c) is State.TRACK and outs[-1] == "move_backward"
 
 
-def test_lost_while_closing_brakes_before_the_search_turns() -> None:
+def lost_while_closing() -> tuple[Controller, Rig, float]:
+    """TRACK closing in at 0.8 m/s from 3 m, then the target lost until the search begins; and the last range."""
     c, rig = to_state(State.TRACK)
     r = 3.0
     for _ in range(6):
@@ -72,6 +73,11 @@ def test_lost_while_closing_brakes_before_the_search_turns() -> None:
         rig.tick(seen(size=size_at(r)))
     while st(c) is not State.SEARCH:
         rig.tick(MISS)
+    return c, rig, r
+
+
+def test_lost_while_closing_brakes_before_the_search_turns() -> None:
+    _, rig, _ = lost_while_closing()
     assert name(rig.tick(MISS)) == "move_backward"  # braking first ...
     turns = [name(rig.tick(MISS)) for _ in range(60)]
     assert turns[-1] in ("turn_left", "turn_right")  # ... then the sweep
@@ -82,13 +88,7 @@ def test_a_sighting_while_braking_at_a_loss_does_not_end_the_brake() -> None:
     """A half-covered target flickers: lost while closing in, then seen every other frame, never confirmed.
     Confirming a sighting goes on with the brake planned at the loss (neutral sticks would coast the drone into
     the cover), for that brake's time and no longer."""
-    c, rig = to_state(State.TRACK)
-    r = 3.0
-    for _ in range(6):
-        r -= 0.04  # 0.8 m/s closer
-        rig.tick(seen(size=size_at(r)))
-    while st(c) is not State.SEARCH:
-        rig.tick(MISS)
+    c, rig, r = lost_while_closing()
     outs, states = [], set()
     for k in range(60):
         outs.append(name(rig.tick(seen(size=size_at(r)) if k % 2 else MISS)))
