@@ -248,7 +248,7 @@ class HsvBlobDetector:
                    joined: list[tuple[float, MatLike, Box]], scale: int, found: list[Features]) -> list[Features]:
         """Balls a few hue units off what they are joined to (a red ball on a red-brown saucer): each joined
         blob whose pixels fall in two hue classes is searched again in each class's hue range, and its round
-        pieces refined in that range (their rings then see only their own hue). One range only (see __init__)."""
+        pieces refined in that range (their rings then see only their own hue). One range only (pilot/hsv_colour.py)."""
         ((lo, hi),) = bounds
         min_area = self.cfg.min_area / (scale * scale)
         out: list[Features] = []

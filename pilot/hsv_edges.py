@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 from cv2.typing import MatLike
 
-from .hsv_shape import share_set
+from .hsv_shape import CIRCLE_48, share_set
 
 CANNY = (60, 150)  # hysteresis thresholds on each 8-bit channel (40-100 and 80-200 found the same balls,
 # bench/vision tuning photos; lower ones fray a ball's shaded side)
@@ -26,8 +26,6 @@ WALL_GROWTH = 2.0  # px: the walls (a 1 px edge grown by a cross) take a pixel o
 
 _CROSS = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))  # an 8-connected edge grown to a 4-connected wall
 _SQUARE = np.ones((3, 3), np.uint8)
-_ANGLES = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
-RIM_POINTS = np.stack([np.cos(_ANGLES), np.sin(_ANGLES)], axis=1)
 
 
 class Cut(NamedTuple):
@@ -66,4 +64,4 @@ def cut_by_edges(roi: MatLike, mask: MatLike, kernel: MatLike | None, min_area: 
 def walled_in(separated: MatLike, contour: MatLike) -> float:
     """The share of the circle just outside the piece's enclosing circle that is an edge or off the mask."""
     (cx, cy), r = cv2.minEnclosingCircle(contour)
-    return share_set(separated, cx, cy, RIM_POINTS, r + 1.5)
+    return share_set(separated, cx, cy, CIRCLE_48, r + 1.5)

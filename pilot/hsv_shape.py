@@ -17,9 +17,16 @@ Flags = npt.NDArray[np.bool_]
 ELLIPSE_TOL = 0.06  # a point within this share of the mean radius (at least 1 px) lies on the fitted ellipse
 ELLIPSE_ASPECT = 1.5  # a longer fit is no ball seen at an angle (the elongation ramp's zero is 2.0)
 
+
+def unit_circle(n: int) -> npt.NDArray[np.float64]:
+    """``n`` points evenly spaced on the unit circle, N x 2 (x, y): offsets to sample a circle in a mask with."""
+    angles = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    return np.stack([np.cos(angles), np.sin(angles)], axis=1)
+
+
+CIRCLE_48 = unit_circle(48)
 # the ring from 1.25 to 1.75 radii, in radii: three circles of 48 points (sampling it costs a third of drawing it)
-_ANGLES = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
-RING_POINTS = np.concatenate([k * np.stack([np.cos(_ANGLES), np.sin(_ANGLES)], axis=1) for k in (1.33, 1.5, 1.67)])
+RING_POINTS = np.concatenate([k * CIRCLE_48 for k in (1.33, 1.5, 1.67)])
 
 
 def share_set(mask: MatLike, cx: float, cy: float, unit: npt.NDArray[np.float64], r: float) -> float:

@@ -12,6 +12,8 @@ import numpy as np
 import numpy.typing as npt
 from cv2.typing import MatLike
 
+from .hsv_shape import unit_circle
+
 PEAK_MIN = 3.0  # pixels: a disc centre nearer than this to the blob's edge is too small to be a ball
 PEAKS_PER_BLOB = 6  # disc centres looked at per blob, widest first
 RIM_MIN = 0.35  # of a circle just outside a disc that leaves the blob: less is no bulge (a disc that merely
@@ -21,8 +23,7 @@ SPLIT_CUT = 0.1  # the opening must cut off this much (of the piece's area): els
 HUE_GAP = 4.0  # hue units between the means of a blob's two hue classes (Otsu) for a split by hue (3: more
 # false detections on the tuning photos' empty views, 2: more still)
 
-_ANGLES = np.linspace(0.0, 2.0 * np.pi, 24, endpoint=False)
-_CIRCLE = np.stack([np.cos(_ANGLES), np.sin(_ANGLES)], axis=1)
+_CIRCLE = unit_circle(24)
 _PEAK_KERNEL = np.ones((3, 3), np.uint8)
 Box = tuple[int, int, int, int]  # x, y, width, height
 
