@@ -5,7 +5,7 @@ height, and returns four motor thrusts. What it reproduces, with ArduCopter's pa
 
 * roll/pitch stick -> lean angle, linear up to ``ANGLE_MAX`` with a circular limit, shaped by a first-order
   filter of ``ATC_INPUT_TC``; a released stick levels the airframe and nothing holds position: it coasts;
-* yaw stick -> yaw rate up to ``PILOT_Y_RATE``;
+* yaw stick -> yaw rate up to ``PILOT_Y_RATE``, reached at no more than ``ATC_ACCEL_Y_MAX``;
 * Stabilize: throttle -> collective, mid-stick at ``MOT_THST_HOVER`` (ArduCopter's throttle curve);
 * AltHold: throttle -> climb rate with the ``THR_DZ`` dead band around mid-stick, up to ``PILOT_SPEED_UP`` /
   ``PILOT_SPEED_DN`` with ``PILOT_ACCEL_Z``, and the altitude held when centred;
@@ -114,6 +114,7 @@ class FlightController:
         self._alt_target = 0.0
         self._roll = 0.0  # shaped lean targets, rad
         self._pitch = 0.0
+        self._yaw_rate = 0.0  # shaped yaw rate target, rad/s
 
     # -- the sticks --------------------------------------------------------------------------------------
     def _arming(self, throttle_zero: bool, yaw_in: float, dt: float) -> None:
@@ -165,7 +166,7 @@ class FlightController:
         self._modes(mode_pwm, throttle_pwm)
         self._arming(throttle <= 0.0, yaw_in, dt)
         if not self.armed:
-            self._roll = self._pitch = self._climb_cmd = 0.0
+            self._roll = self._pitch = self._climb_cmd = self._yaw_rate = 0.0
             self.landed = abs(s.climb) < 0.1  # resting (on the floor or on a table), not falling
             return Demand(0.0, 0.0, 0.0, 0.0, False)
         want_roll, want_pitch = desired_lean(self.p, roll_in, pitch_in)
@@ -182,17 +183,19 @@ class FlightController:
         self._land_detector(climb_demand, collective, s, dt)
         if self.landed:
             # spooled down on the ground: no lean, no turn, motors at their floor until a climb is asked for
-            self._roll = self._pitch = 0.0
+            self._roll = self._pitch = self._yaw_rate = 0.0
             if self.mode is Mode.LAND or self.failsafe:
                 self.armed = False
             return Demand(0.0, 0.0, 0.0, 0.0, self.armed)
         a = min(1.0, dt / self.p["ATC_INPUT_TC"])
         self._roll += (want_roll - self._roll) * a
         self._pitch += (want_pitch - self._pitch) * a
+        turn = math.radians(self.p["ATC_ACCEL_Y_MAX"] / 100.0) * dt
+        self._yaw_rate += max(-turn, min(turn, yaw_rate - self._yaw_rate))
         if self._crashed(s, dt):
             return Demand(0.0, 0.0, 0.0, 0.0, False)
         tilt = max(0.5, math.cos(s.roll) * math.cos(s.pitch))
-        return Demand(self._roll, self._pitch, yaw_rate, collective / tilt, True)
+        return Demand(self._roll, self._pitch, self._yaw_rate, collective / tilt, True)
 
     def _vertical(self, climb_target: float, s: Sensors, dt: float) -> tuple[float, float]:
         """AltHold's vertical controller: the collective (before tilt compensation) and the climb demand."""

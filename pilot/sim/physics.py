@@ -17,9 +17,10 @@ import numpy.typing as npt
 
 from . import mj
 from .arducopter import FlightController, Sensors
+from .mixer import Mixer
 from .rc import SimParams
 from .room import Scenario
-from .scene import HIDDEN_GROUP, MOTOR_SPIN, motor_positions
+from .scene import HIDDEN_GROUP
 
 FloatArray = npt.NDArray[np.float64]
 HIT_GAP_S = 0.5
@@ -49,16 +50,6 @@ def _euler(w: float, x: float, y: float, z: float) -> tuple[float, float, float]
     return roll, pitch, yaw
 
 
-def _mixer(arm: float, yaw_moment: float) -> FloatArray:
-    """Thrusts from (collective force, roll torque, pitch torque, yaw torque) in the body frame (FLU)."""
-    rows = np.array([[1.0] * 4,
-                     [y for _, y in motor_positions(arm)],
-                     [-x for x, _ in motor_positions(arm)],
-                     [s * yaw_moment for s in MOTOR_SPIN]])
-    inverse: FloatArray = np.linalg.inv(rows)
-    return inverse
-
-
 class Airframe:
     def __init__(self, scenario: Scenario, params: SimParams, model: mj.Model, data: mj.Data) -> None:
         mujoco = mj.module()
@@ -67,9 +58,9 @@ class Airframe:
         self.frame = frame
         self.fc = FlightController(params, frame.mass_kg, 4.0 * frame.motor_max_n)
         self.state = AirframeState(x=scenario.start[0], y=scenario.start[1], heading=scenario.start[2])
-        self._mix_rows = _mixer(frame.arm_m, frame.yaw_moment_m).tolist()
         self._kp_roll, self._kp_pitch = params["ATC_ANG_RLL_P"], params["ATC_ANG_PIT_P"]
-        self._spin_min_n = params["MOT_SPIN_MIN"] * frame.motor_max_n
+        self._mixer = Mixer(frame.arm_m, frame.yaw_moment_m, params["MOT_SPIN_MIN"] * frame.motor_max_n,
+                            frame.motor_max_n, params["MOT_YAW_HEADROOM"])
         self._moving = scenario.target_motion[0] != 0.0 or scenario.target_motion[1] != 0.0
         self._hides = bool(scenario.hidden)
         self.body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "drone")
@@ -114,10 +105,7 @@ class Airframe:
                       ix * gain * (self._kp_roll * (demand.roll - s.roll) - rates[3]),
                       iy * gain * (-self._kp_pitch * (demand.pitch - s.pitch) - rates[4]),
                       iz * gain * (-demand.yaw_rate - rates[5]))
-            floor, top = self._spin_min_n, frame.motor_max_n
-            for i, row in enumerate(self._mix_rows):
-                thrust = row[0] * wrench[0] + row[1] * wrench[1] + row[2] * wrench[2] + row[3] * wrench[3]
-                ctrl[i] = floor if thrust < floor else top if thrust > top else thrust
+            ctrl[:] = self._mixer.thrusts(*wrench)
         self._air()
         if self._moving or self._hides:
             self._target()

@@ -1,0 +1,60 @@
+"""The simulated motor mixer keeps ArduCopter's priorities: roll and pitch before yaw, attitude before the
+collective."""
+
+from __future__ import annotations
+
+import pytest
+
+from pilot.sim import rc
+from pilot.sim.mixer import Mixer
+from pilot.sim.scene import MOTOR_SPIN, motor_positions
+
+FRAME = rc.load().airframe
+FLOOR = 0.15 * FRAME.motor_max_n
+TOP = FRAME.motor_max_n
+HOVER = FRAME.mass_kg * 9.81
+
+
+def mixer(headroom: float = 200.0) -> Mixer:
+    return Mixer(FRAME.arm_m, FRAME.yaw_moment_m, FLOOR, TOP, headroom)
+
+
+def wrench(thrusts: list[float]) -> tuple[float, float, float, float]:
+    """Collective force and the roll, pitch and yaw torques four thrusts make (FLU)."""
+    pos = motor_positions(FRAME.arm_m)
+    return (sum(thrusts),
+            sum(t * y for t, (_, y) in zip(thrusts, pos, strict=True)),
+            sum(-t * x for t, (x, _) in zip(thrusts, pos, strict=True)),
+            sum(t * s * FRAME.yaw_moment_m for t, s in zip(thrusts, MOTOR_SPIN, strict=True)))
+
+
+def test_a_demand_within_the_motors_range_is_met_exactly() -> None:
+    demand = (HOVER, 0.3, -0.2, 0.05)
+    thrusts = mixer().thrusts(*demand)
+    assert all(FLOOR <= t <= TOP for t in thrusts)
+    assert wrench(thrusts) == pytest.approx(demand, abs=1e-9)
+
+
+def test_a_yaw_demand_past_the_motors_authority_leaves_roll_and_pitch_whole() -> None:
+    """A wall touch spins the airframe: the yaw demand saturates, and the lean the airframe needs still comes."""
+    thrusts = mixer().thrusts(HOVER, 0.4, -0.3, 2.0)
+    force, roll, pitch, yaw = wrench(thrusts)
+    assert all(FLOOR - 1e-9 <= t <= TOP + 1e-9 for t in thrusts)
+    assert (roll, pitch) == pytest.approx((0.4, -0.3), abs=1e-9)
+    assert 0.0 < yaw < 2.0  # what is left goes to yaw, in its sense
+    assert force == pytest.approx(HOVER, rel=0.05)
+
+
+def test_the_yaw_headroom_is_kept_even_when_roll_and_pitch_take_everything() -> None:
+    full_roll = 10.0  # more than four motors can make: roll, pitch and yaw are scaled down together
+    without = wrench(mixer(0.0).thrusts(HOVER, full_roll, 0.0, 1.0))
+    kept = wrench(mixer(200.0).thrusts(HOVER, full_roll, 0.0, 1.0))
+    assert without[3] == pytest.approx(0.0, abs=1e-9) and kept[3] > 0.0
+    assert 0.0 < kept[1] < full_roll
+
+
+def test_attitude_comes_before_the_collective_near_the_top() -> None:
+    thrusts = mixer().thrusts(4 * TOP, 0.5, 0.0, 0.0)  # full collective and a roll demand
+    force, roll, _, _ = wrench(thrusts)
+    assert roll == pytest.approx(0.5, abs=1e-9) and force < 4 * TOP
+    assert max(thrusts) == pytest.approx(TOP)
