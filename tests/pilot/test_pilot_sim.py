@@ -8,46 +8,14 @@ import math
 import drone_protocol as dp
 import numpy as np
 import pytest
+from sim_rig import ALT_HOLD, CH, MEDIANS, PARAMS, STABILIZE, Rig
 
 from pilot.detect import HsvBlobDetector
-from pilot.sim import mj, rc
 from pilot.sim.arducopter import FlightController, Mode, Sensors, desired_climb_rate, desired_lean
 from pilot.sim.camera import CameraModel, rolling_shutter
-from pilot.sim.physics import Airframe
 from pilot.sim.room import SCENARIOS, make_scenario
-from pilot.sim.scene import HIDDEN_GROUP, build
+from pilot.sim.scene import HIDDEN_GROUP
 from pilot.sim.still import StillView
-
-CH = dp.CHANNELS
-PARAMS = rc.load()
-ALT_HOLD = dp.MODE_ALT_HOLD_US
-STABILIZE = dp.MODE_STABILIZE_US
-MEDIANS = {n: float(CH[dp.ChannelName(n)].median) for n in ("roll", "pitch", "throttle", "yaw")}
-
-
-class Rig:
-    """The airframe alone in a scenario's room, driven by pulses."""
-
-    def __init__(self, name: str = "ahead", seed: int = 0) -> None:
-        mujoco = mj.module()
-        sc = make_scenario(name, seed, noise=False)
-        built = build(sc, PARAMS.airframe, 64, 48, 45.0)
-        self.model = mujoco.MjModel.from_xml_string(built.xml, built.assets)
-        self.data = mujoco.MjData(self.model)
-        self.af = Airframe(sc, PARAMS, self.model, self.data)
-
-    def run(self, seconds: float, mode: float = ALT_HOLD, **sticks: float) -> None:
-        p = {**MEDIANS, **sticks}
-        for _ in range(round(seconds / 0.002)):
-            self.af.step((p["roll"], p["pitch"], p["throttle"], p["yaw"], mode), 0.002)
-
-    def airborne(self) -> Rig:
-        self.run(2.2, STABILIZE, throttle=CH["throttle"].minimum, yaw=CH["yaw"].maximum)
-        assert self.af.fc.armed
-        self.run(3.0, throttle=CH["throttle"].high)
-        self.run(2.0)
-        assert self.af.state.z > 1.0 and not self.af.fc.landed
-        return self
 
 
 def test_parameters_come_from_the_generated_file() -> None:

@@ -3,7 +3,10 @@ collective."""
 
 from __future__ import annotations
 
+import math
+
 import pytest
+from sim_rig import CH, Rig
 
 from pilot.sim import rc
 from pilot.sim.mixer import Mixer
@@ -58,3 +61,19 @@ def test_attitude_comes_before_the_collective_near_the_top() -> None:
     force, roll, _, _ = wrench(thrusts)
     assert roll == pytest.approx(0.5, abs=1e-9) and force < 4 * TOP
     assert max(thrusts) == pytest.approx(TOP)
+
+
+def test_a_wall_touch_while_turning_leaves_the_airframe_upright() -> None:
+    """Blown into a wall at 0.4 m/s mid-turn (a search in gusts): the touch spins the airframe, the saturated
+    yaw demand no longer takes the lean authority, and it hovers on, level and armed."""
+    rig = Rig("ahead", 0).airborne()
+    data, width = rig.data, rig.af.sc.room.width
+    data.qpos[0], data.qpos[1] = width - FRAME.radius_m - 0.3, rig.af.sc.room.depth / 2.0
+    data.qvel[:] = 0.0
+    data.qvel[0] = 0.4
+    rig.run(3.0, yaw=CH["yaw"].maximum)
+    state = rig.af.state
+    assert state.wall_hits >= 1 and state.crashes == 0 and rig.af.fc.armed
+    sensors = rig.af.sensors()
+    assert abs(sensors.roll) < math.radians(10) and abs(sensors.pitch) < math.radians(10)
+    assert state.z > 0.8
