@@ -130,7 +130,8 @@ def speed_probe(executable: str | None) -> list[str]:
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--seeds", type=int, default=8, help="seeds per scenario and detector (14 scenarios)")
-    p.add_argument("--gust-seeds", type=int, default=2, help="seeds per scenario with gusts (HSV)")
+    p.add_argument("--gust-seeds", type=int, default=4,
+                   help="seeds per scenario with gusts (HSV; 56 flights: one crash is 1.8 %%, within the 2 %% goal)")
     p.add_argument("--processes", type=int, default=os.cpu_count() or 1)
     p.add_argument("--virtual-drone", default=os.environ.get("PILOT_VIRTUAL_DRONE"))
     p.add_argument("--summarize", action="store_true", help="only rewrite RESULTS.md from the last campaign's log")
