@@ -50,7 +50,6 @@ there, or any blob from ``HALF_MEASURE`` px, skips the refinement and its fixed 
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import cv2
 import numpy as np
@@ -60,6 +59,20 @@ from .config import HsvConfig, VisionConfig
 from .detection import Candidate, Detection, best_detection, frame_size, range_of
 from .hsv_colour import Bounds, ColourMask, darker
 from .hsv_edges import MIN_SIZE, WALL_GROWTH, cut_by_edges, walled_in
+from .hsv_score import (
+    ARC,
+    ARC_TOL,
+    ELONGATION,
+    FILL,
+    HUE_OFF,
+    RING,
+    SATURATION,
+    SIZE,
+    SOLIDITY,
+    Features,
+    arc_score,
+    ramp,
+)
 from .hsv_shape import ELLIPSE_ASPECT, RING_POINTS, ellipse_support, outer_rim, share_set
 from .hsv_split import disc_centres, hue_split, round_pieces, split_off
 
@@ -82,46 +95,10 @@ SECOND_LOOK_UNLESS = 0.6  # nothing scoring this (the default acquisition thresh
 SECOND_LOOK_GAIN = 0.8  # ...with the V bound this much lower (a ball's shaded side, a dim or backlit ball)...
 SECOND_LOOK_MIN = 0.75  # ...keeps what scores this: a fallback needs stronger evidence (tuning photos' empty views)
 RIM_STEP = 2.0  # px outwards from a contour point where the unopened mask must be unset for a real edge
-# score ramps (zero, one), set on the tuning photos only (bench/vision/RESULTS.md)
-ARC = (0.3, 0.6)
-ARC_TOL = 0.12  # a contour point within this share of the radius (at least 1.5 px) lies on the circle
-ELLIPSE_ARC = (0.7, 0.9)  # the share on the fitted ellipse (pilot/hsv_shape.py): squares reach 0.5-0.8
-SOLIDITY = (0.7, 0.88)
-FILL = (0.35, 0.6)
-ELONGATION = (2.0, 1.4)  # minimum-area rectangle, longer side over shorter (falling ramp)
-SATURATION = (10.0, 60.0)  # mean saturation above the S bound (pink and pale red sit just over it)
-HUE_OFF = (0.6, 1.0)  # mean hue's distance from the range's middle, in half-widths
-RING = (0.35, 0.1)  # share of the ring of the target's colour (falling ramp)
-SIZE = (8.0, 16.0)  # diameter, pixels: a smaller blob has too few pixels to show its shape
 AIM_SPAN, AIM_SHARE = 0.35, 0.8  # the aim point's window (of the ball's diameter), and its share of target colour
 
 
 Box = tuple[int, int, int, int]  # x, y, width, height
-
-
-class Features(NamedTuple):
-    """What the score of one blob is made of (bench/vision tunes the ramps on these)."""
-
-    cx: float
-    cy: float
-    size: float  # diameter of the fitted circle, pixels
-    arc: float
-    solidity: float
-    fill: float
-    elongation: float
-    saturation: float  # mean, 0..255
-    hue_off: float  # mean hue's distance from the range's middle, in half-widths
-    ring: float  # the ring's share of the target's colour (a piece cut by edges: its rim's share not walled in)
-    ellipse_arc: float  # 0 where the circle's arc was enough (it is measured only below ARC's one)
-
-
-def _ramp(value: float, zero: float, one: float) -> float:
-    v = (value - zero) / (one - zero)  # compared, not clamped with min/max: about 40 calls a frame
-    return 0.0 if v <= 0.0 else 1.0 if v >= 1.0 else v
-
-
-def _arc_score(arc: float, ellipse_arc: float) -> float:
-    return max(_ramp(arc, *ARC), _ramp(ellipse_arc, *ELLIPSE_ARC))
 
 
 def _new(f: Features, found: list[Features]) -> bool:
@@ -330,13 +307,13 @@ class HsvBlobDetector:
         (_, _), (rw, rh), _ = cv2.minAreaRect(c)
         elongation = max(rw, rh) / max(1e-6, min(rw, rh))
         fill = area / (math.pi * r * r) if r > 0 else 0.0
-        geometry = self._size_score(size, self._width) * _ramp(fill, *FILL)
-        geometry *= _ramp(elongation, *ELONGATION)
+        geometry = self._size_score(size, self._width) * ramp(fill, *FILL)
+        geometry *= ramp(elongation, *ELONGATION)
         if geometry <= 0.0 or geometry < self.cfg.min_score:
             return None
         # the ring from 1.25 to 1.75 radii, sampled: outside the blob's circle, so the mask there is something else
         ring = share_set(mask, cx, cy, RING_POINTS, max(r, 2.0))
-        geometry *= _ramp(ring, *RING)
+        geometry *= ramp(ring, *RING)
         if geometry <= 0.0 or geometry < self.cfg.min_score:
             return None
         pts = c.reshape(-1, 2)
@@ -352,7 +329,7 @@ class HsvBlobDetector:
         ellipse_arc = ellipse_support(pts, real) if arc < ARC[1] and fill >= 1.0 / ELLIPSE_ASPECT else 0.0
         hull = float(cv2.contourArea(cv2.convexHull(c)))
         solidity = area / hull if hull > 0 else 0.0
-        geometry *= _arc_score(arc, ellipse_arc) * _ramp(solidity, *SOLIDITY)
+        geometry *= arc_score(arc, ellipse_arc) * ramp(solidity, *SOLIDITY)
         if geometry <= 0.0 or geometry < self.cfg.min_score:
             return None
         # colour: the mean over the blob's box (the mask's pixels there are the blob's, or nearly)
@@ -369,14 +346,14 @@ class HsvBlobDetector:
         distance = range_of(size, self.cfg.target_diameter_m, width, self.fov_deg)
         if not self.vision.range_min_m <= distance <= self.vision.range_max_m:
             return 0.0
-        return _ramp(size, *SIZE)
+        return ramp(size, *SIZE)
 
     def score(self, f: Features, width: int) -> float:
-        shape = _arc_score(f.arc, f.ellipse_arc) * _ramp(f.solidity, *SOLIDITY) * _ramp(f.fill, *FILL)
-        shape *= _ramp(f.elongation, *ELONGATION) * self._size_score(f.size, width)
-        colour = _ramp(f.saturation, self.colour.sat_lo + SATURATION[0], self.colour.sat_lo + SATURATION[1])
-        colour *= 1.0 - _ramp(f.hue_off, *HUE_OFF)
-        return shape * colour * _ramp(f.ring, *RING)
+        shape = arc_score(f.arc, f.ellipse_arc) * ramp(f.solidity, *SOLIDITY) * ramp(f.fill, *FILL)
+        shape *= ramp(f.elongation, *ELONGATION) * self._size_score(f.size, width)
+        colour = ramp(f.saturation, self.colour.sat_lo + SATURATION[0], self.colour.sat_lo + SATURATION[1])
+        colour *= 1.0 - ramp(f.hue_off, *HUE_OFF)
+        return shape * colour * ramp(f.ring, *RING)
 
     def candidates(self, image: MatLike) -> list[Candidate]:
         width = frame_size(image)[0]
