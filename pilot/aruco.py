@@ -103,3 +103,7 @@ class ArucoMarkerDetector:
     def aim_on_target(self, image: MatLike, size: float) -> bool | None:
         """Not measured: a marker is black and white like much else, and a marker partly covered is not read."""
         return None
+
+    def candidates_near(self, image: MatLike, cx: float, cy: float, size: float) -> list[Candidate]:
+        """None: a marker's cells are read whole or not at all, and the frame's look read them already."""
+        return []

@@ -33,8 +33,11 @@ class TrackedDetector:
     """Frame checks, a single-frame detector and the tracker, behind ``detect(image) -> Detection``."""
 
     def __init__(
-        self, source: CandidateSource, object_m: float, fov_deg: float, vision: VisionConfig | None = None
+        self, source: CandidateSource, object_m: float, fov_deg: float, vision: VisionConfig | None = None,
+        look_again_from: float = 0.6,
     ) -> None:
+        """``look_again_from``: the tracked score from which a lost target gets a closer look (the controller's
+        ``acquire_confidence``)."""
         self.source = source
         self.name = source.name
         self.object_m = object_m
@@ -42,6 +45,7 @@ class TrackedDetector:
         cfg = vision or VisionConfig()
         self.frames = FrameCheck(cfg.frozen_frames)
         self.tracker = Tracker(cfg)
+        self.look_again_from = look_again_from
 
     def detect(self, image: MatLike) -> Detection:
         status = self.frames.check(image)
@@ -50,7 +54,14 @@ class TrackedDetector:
         if status is not FrameStatus.OK:
             self.tracker.reset()  # nothing seen through a bad frame carries over
             return Detection(False, width=w, height=h, status=status)
-        out = self.tracker.update(self.source.candidates(image), w)
+        candidates = self.source.candidates(image)
+        expected = self.tracker.expected()
+        if expected is not None and self.tracker.score >= self.look_again_from and not self.tracker.takes(
+                candidates, w):
+            # a target the pilot acts on, not in this frame's look: a closer look where it should be (a ball
+            # darkening as a bright window fills more of the frame drops under the frame's V bound)
+            candidates = candidates + self.source.candidates_near(image, *expected)
+        out = self.tracker.update(candidates, w)
         if out is None:
             return Detection(False, width=w, height=h)
         c = out.candidate
@@ -69,4 +80,4 @@ def make_detector(config: PilotConfig) -> TrackedDetector:
         source, size = ArucoMarkerDetector(config.aruco, config.vision, fov), config.aruco.marker_size_m
     else:
         raise ConfigError(f"option 'detector' must be 'hsv' or 'aruco', got {config.detector!r}")
-    return TrackedDetector(source, size, fov, config.vision)
+    return TrackedDetector(source, size, fov, config.vision, config.controller.acquire_confidence)

@@ -78,6 +78,11 @@ class CandidateSource(Protocol):
         """Whether the frame's centre shows the target's own surface (None: this detector cannot tell)."""
         ...
 
+    def candidates_near(self, image: MatLike, cx: float, cy: float, size: float) -> list[Candidate]:
+        """A closer look where a tracked target of ``size`` px is expected and the frame's look found nothing:
+        the candidates there, best first (none: this detector has no closer look)."""
+        ...
+
 
 def focal_px(width: int, horizontal_fov_deg: float) -> float:
     return (width / 2.0) / math.tan(math.radians(horizontal_fov_deg) / 2.0)

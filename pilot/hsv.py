@@ -94,6 +94,8 @@ SPLIT_UNLESS = 0.8  # a candidate scoring this already: no split (0.1-0.3 ms a d
 SECOND_LOOK_UNLESS = 0.6  # nothing scoring this (the default acquisition threshold): a second look...
 SECOND_LOOK_GAIN = 0.8  # ...with the V bound this much lower (a ball's shaded side, a dim or backlit ball)...
 SECOND_LOOK_MIN = 0.75  # ...keeps what scores this: a fallback needs stronger evidence (tuning photos' empty views)
+NEAR_GAIN = 0.5  # a tracked ball's closer look: the V bound this much lower...
+NEAR_MARGIN = 0.1  # ...in a window this share of the frame's width wider than the ball on each side
 RIM_STEP = 2.0  # px outwards from a contour point where the unopened mask must be unset for a real edge
 AIM_SPAN, AIM_SHARE = 0.35, 0.8  # the aim point's window (of the ball's diameter), and its share of target colour
 
@@ -365,6 +367,21 @@ class HsvBlobDetector:
         found.sort(key=lambda c: c.score, reverse=True)
         return found
 
+    def candidates_near(self, image: MatLike, cx: float, cy: float, size: float) -> list[Candidate]:
+        """Where a tracked ball should be and the frame's look found nothing: that window refined with the V
+        bound ``NEAR_GAIN`` times as high. The frame's bound follows its brightest part: a ball against a
+        bright window darkens under it as the window fills more of the frame, while still plainly a red disc."""
+        w, h = frame_size(image)
+        self._width = w
+        half = size / 2.0 + NEAR_MARGIN * w
+        x0, y0 = max(0, int(cx - half)), max(0, int(cy - half))
+        x1, y1 = min(w, int(cx + half) + 1), min(h, int(cy + half) + 1)
+        if x1 - x0 < 2 or y1 - y0 < 2:
+            return []
+        found = self._refine(image, darker(self.colour.bounds_for(image), NEAR_GAIN), (x0, y0, x1 - x0, y1 - y0))
+        near = [Candidate(f.cx, f.cy, f.size, s) for f in found if (s := self.score(f, w)) >= self.cfg.min_score]
+        return sorted(near, key=lambda c: c.score, reverse=True)
+
     def detect(self, image: MatLike) -> Detection:
         """This frame alone, the best candidate (no tracking, no frame checks)."""
         return best_detection(self, image, self.cfg.target_diameter_m, self.fov_deg)
@@ -372,6 +389,7 @@ class HsvBlobDetector:
     def aim_on_target(self, image: MatLike, size: float) -> bool:
         """Whether the laser's aim point (the frame's centre) shows the target's colour, in a window a third of
         the ball across: something in front of a centred ball hides its middle while the circle fitted to its
-        rim stays centred, and it reaches the window's edge a frame or two before the middle."""
+        rim stays centred, and it reaches the window's edge a frame or two before the middle. The V bound is the
+        closer look's (``NEAR_GAIN``): the ball it found in shade is in shade at its middle too."""
         r = max(2, min(round(AIM_SPAN * size / 2.0), image.shape[0] // 4))
-        return self.colour.centre_share(image, r) >= AIM_SHARE
+        return self.colour.centre_share(image, r, NEAR_GAIN) >= AIM_SHARE

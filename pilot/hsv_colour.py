@@ -99,9 +99,10 @@ class ColourMask:
         """The full-resolution mask (with the exposure-adapted V bound), as the refinement sees it."""
         return self.clean(self.raw(image, self.bounds_for(image)))
 
-    def centre_share(self, image: MatLike, r: int) -> float:
-        """The share of the (2 r + 1)-pixel square at the frame's centre that is of the target's colour."""
+    def centre_share(self, image: MatLike, r: int, gain: float = 1.0) -> float:
+        """The share of the (2 r + 1)-pixel square at the frame's centre that is of the target's colour (with the
+        frame's V bound ``gain`` times as high)."""
         h, w = image.shape[:2]
         roi = image[h // 2 - r: h // 2 + r + 1, w // 2 - r: w // 2 + r + 1]
-        mask = self.raw(np.ascontiguousarray(roi), self.bounds_for(image))
+        mask = self.raw(np.ascontiguousarray(roi), darker(self.bounds_for(image), gain))
         return cv2.countNonZero(mask) / mask.size

@@ -72,6 +72,27 @@ class Tracker:
         self.size = 0.5 * self.size + 0.5 * c.size
         self.score, self.misses = c.score, 0
 
+    def expected(self) -> tuple[float, float, float] | None:
+        """Where (x, y) and how large the next frame should show the target, if a track lives."""
+        if self._x is None:
+            return None
+        x = F @ self._x
+        return float(x[0]), float(x[1]), self.size
+
+    def takes(self, candidates: list[Candidate], width: int) -> bool:
+        """Whether the next ``update`` would find the target among ``candidates`` (a track lives)."""
+        expected = self.expected()
+        return expected is not None and self._match(candidates, expected[0], expected[1], width) is not None
+
+    def _match(self, candidates: list[Candidate], px: float, py: float, width: int) -> Candidate | None:
+        """The best candidate within reach of (px, py) with a size consistent with the track's."""
+        reach = self.cfg.max_jump * width + self.size
+        for c in candidates:  # best first
+            near = (c.cx - px) ** 2 + (c.cy - py) ** 2 <= reach * reach
+            if near and 1.0 / SIZE_RATIO <= c.size / self.size <= SIZE_RATIO:
+                return c
+        return None
+
     def update(self, candidates: list[Candidate], width: int) -> TrackOutput | None:
         """One frame: the candidates (best first) -> the target's candidate, measured or predicted, or None."""
         if self._x is None:
@@ -84,12 +105,10 @@ class Tracker:
         self._p = F @ self._p @ F.T + np.diag([q / 4, q / 4, q, q])
         self.age += 1
         px, py = float(self._x[0]), float(self._x[1])
-        reach = self.cfg.max_jump * width + self.size
-        for c in candidates:  # best first
-            near = (c.cx - px) ** 2 + (c.cy - py) ** 2 <= reach * reach
-            if near and 1.0 / SIZE_RATIO <= c.size / self.size <= SIZE_RATIO:
-                self._correct(c)
-                return TrackOutput(c, False)
+        c = self._match(candidates, px, py, width)
+        if c is not None:
+            self._correct(c)
+            return TrackOutput(c, False)
         self.misses += 1
         if self.misses <= self.cfg.bridge_frames:
             return TrackOutput(Candidate(px, py, self.size, self.score * BRIDGE_DECAY**self.misses), True)
