@@ -136,9 +136,9 @@ class HsvBlobDetector:
         nothing scoring ``SECOND_LOOK_UNLESS``."""
         w, h = frame_size(image)
         self._width = w
-        bounds = self.colour.bounds_for(image)
         scale = 2 if w >= SEARCH_MIN_WIDTH else 1
         small = cv2.resize(image, (w // scale, h // scale), interpolation=cv2.INTER_AREA) if scale > 1 else image
+        bounds = self.colour.bounds_for(small)  # the exposure read where the resize has just been: in cache
         small_hsv = cv2.cvtColor(small, self.colour.code)
         found = self._look(image, bounds, small_hsv, scale)
         lower = darker(bounds, SECOND_LOOK_GAIN)
