@@ -7,7 +7,8 @@ The pipeline (each part in its own module):
 2. A single-frame detector lists scored candidates: ``pilot.hsv`` (a coloured ball) or ``pilot.aruco``
    (a marker).
 3. ``pilot.tracking``: one track picks the candidate consistent with the last frames, rejects jumps and
-   bridges a few missed frames.
+   bridges a few missed frames. A target the pilot acts on that the frame's look misses first gets a closer
+   look where the track expects it (``candidates_near``).
 4. The controller's ``pilot.gating.Gate`` turns confidences into "act on it" and "the laser may fire".
 """
 

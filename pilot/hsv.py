@@ -43,6 +43,9 @@ high, keeping what scores ``SECOND_LOOK_MIN``: a ball's shaded side, or a ball i
 the bound (a lower bound for every frame joined dark red-brown surfaces to the balls on the tuning photos; steps 3
 and 4 in it too found a few balls more for 0.15x the floor more in bench/vision's median).
 
+A tracked ball the frame's look misses gets a closer look where the track expects it (``candidates_near``, called
+by pilot/detect.py): that window refined with the V bound ``NEAR_GAIN`` times as high.
+
 A search blob from ``HALF_TRY`` px across is first measured on the search itself: a plain disc scoring high
 there, or any blob from ``HALF_MEASURE`` px, skips the refinement and its fixed cost.
 """
