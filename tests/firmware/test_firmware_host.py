@@ -55,7 +55,7 @@ def test_movement_is_refused_while_disarmed(spec: dp.CommandSpec) -> None:
 def test_arming_holds_throttle_low_and_yaw_right_for_the_arming_time() -> None:
     script = fw.Script().step(10).send(dp.arm())
     # Keep the link alive during the hold, as the Pi must; servo_reset changes nothing here.
-    for _ in range(12):
+    for _ in range(dp.ARMING_HOLD_MS // 200 + 2):
         script.step(200).send(dp.servo_reset())
     trace = script.step(50).run()
     assert trace.replies(since_ms=10)[0] == fw.accepted(dp.arm())
@@ -75,7 +75,7 @@ def test_disarming_holds_throttle_low_and_yaw_left_then_disarms() -> None:
     script = fw.Script().arm().step(10)  # on the ground: ik0000 is honoured (in the air it is refused)
     t0 = script.t_ms
     script.send(dp.disarm())
-    for _ in range(12):
+    for _ in range(dp.ARMING_HOLD_MS // 200 + 2):
         script.step(200).send(dp.servo_reset())
     trace = script.step(10).run()
     assert fw.accepted(dp.disarm()) in trace.replies(since_ms=t0)

@@ -64,7 +64,7 @@ def test_the_edited_spec_generates_a_handler_less_dispatch_fallback(edited: fw.B
 def test_new_frames_in_the_virtual_drone(edited: fw.Built) -> None:
     script = fw.Script()
     script.send(edited.frame("arm", 0)).step(1)
-    for _ in range(11):
+    for _ in range(dp.ARMING_HOLD_MS // 200 + 1):  # past the arming hold, the link kept alive
         script.step(200).send(edited.frame("servo_reset", 0))
     t0 = script.step(5).t_ms
     sends, expected = plan(edited)

@@ -211,3 +211,18 @@ def test_the_rolling_shutter_option_changes_only_frames_taken_while_turning() ->
         frames[readout] = shots
     assert np.array_equal(frames[0.0][1], frames[0.03][1])  # not turning: a global and a rolling shutter agree
     assert not np.array_equal(frames[0.0][2], frames[0.03][2])
+
+
+def test_the_firmware_landing_routine_disarms_the_flight_controller_from_under_the_ceiling() -> None:
+    """The landing routine (``il0000``): AltHold with the throttle at its low speed for LANDING_MS, then the disarm
+    sticks for ARMING_HOLD_MS. From 2.6 m (the room is 3 m high) the flight controller must be down, past its land
+    detector, and disarmed by the end: a 6 s landing was too short for 2.4 m, and a hold of exactly 2 s left the
+    20th tick of ArduCopter's 10 Hz check to its phase (here it fell after the hold)."""
+    rig = Rig().airborne()
+    while rig.af.state.z < 2.6:
+        rig.run(0.1, throttle=CH["throttle"].high)
+    rig.run(1.0)  # settled at the top
+    rig.run(dp.LANDING_MS / 1000.0, throttle=CH["throttle"].low)
+    assert rig.af.state.z < 0.02
+    rig.run(dp.ARMING_HOLD_MS / 1000.0, throttle=CH["throttle"].minimum, yaw=CH["yaw"].minimum)
+    assert not rig.af.fc.armed
