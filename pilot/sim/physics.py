@@ -1,10 +1,11 @@
 """The airframe in MuJoCo, flown by the emulated flight controller from the virtual drone's RC pulses.
 
 Each 2 ms step: the flight controller reads the pulses and the airframe's attitude, rates and height
-(``arducopter.py``), an attitude and rate loop turns its demand into four motor thrusts (MuJoCo's actuators add
-the motor lag and the reaction torques), drag against the moving air (steady wind plus seeded gusts) is applied,
-and MuJoCo integrates. Contacts are scored: a wall, furniture or target touch is a wall hit; touching the floor
-faster than the airframe's crash speed, or tipping over, is a crash.
+(``arducopter.py``), an attitude and rate loop (with integrators on roll and pitch) turns its demand into torques,
+the mixer (``mixer.py``) into four motor thrusts (MuJoCo's actuators add the motor lag and the reaction torques),
+drag against the moving air (steady wind plus seeded gusts) is applied, and MuJoCo integrates. Contacts are
+scored: a wall, furniture or target touch is a wall hit; touching the floor faster than the airframe's crash
+speed, or tipping over, is a crash.
 """
 
 from __future__ import annotations
@@ -59,6 +60,12 @@ class Airframe:
         self.fc = FlightController(params, frame.mass_kg, 4.0 * frame.motor_max_n)
         self.state = AirframeState(x=scenario.start[0], y=scenario.start[1], heading=scenario.start[2])
         self._kp_roll, self._kp_pitch = params["ATC_ANG_RLL_P"], params["ATC_ANG_PIT_P"]
+        # the rate loops' integrators (ArduCopter's ATC_RAT_*_I over _P, per second, capped at ATC_RAT_*_IMAX of
+        # full authority): a steady torque (a wall touch's friction, an off-centre load) is worked off
+        self._ki = frame.rate_gain * params["ATC_RAT_RLL_I"] / params["ATC_RAT_RLL_P"]
+        full = 2.0 * frame.motor_max_n * frame.arm_m / math.sqrt(2.0)  # torque of two motors' full thrust
+        self._i_max_x = self._i_max_y = params["ATC_RAT_RLL_IMAX"] * full
+        self._i_x = self._i_y = 0.0
         self._mixer = Mixer(frame.arm_m, frame.yaw_moment_m, params["MOT_SPIN_MIN"] * frame.motor_max_n,
                             frame.motor_max_n, params["MOT_YAW_HEADROOM"])
         self._moving = scenario.target_motion[0] != 0.0 or scenario.target_motion[1] != 0.0
@@ -101,9 +108,16 @@ class Airframe:
             rates = self.data.qvel
             gain = frame.rate_gain
             ix, iy, iz = frame.inertia
+            err_x = self._kp_roll * (demand.roll - s.roll) - rates[3]
+            err_y = -self._kp_pitch * (demand.pitch - s.pitch) - rates[4]
+            if self.fc.landed:
+                self._i_x = self._i_y = 0.0  # ArduCopter resets its rate integrators on the ground
+            else:
+                self._i_x = min(max(self._i_x + ix * self._ki * err_x * dt, -self._i_max_x), self._i_max_x)
+                self._i_y = min(max(self._i_y + iy * self._ki * err_y * dt, -self._i_max_y), self._i_max_y)
             wrench = (demand.collective * 4.0 * frame.motor_max_n,
-                      ix * gain * (self._kp_roll * (demand.roll - s.roll) - rates[3]),
-                      iy * gain * (-self._kp_pitch * (demand.pitch - s.pitch) - rates[4]),
+                      ix * gain * err_x + self._i_x,
+                      iy * gain * err_y + self._i_y,
                       iz * gain * (-demand.yaw_rate - rates[5]))
             ctrl[:] = self._mixer.thrusts(*wrench)
         self._air()

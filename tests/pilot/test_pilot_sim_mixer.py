@@ -77,3 +77,18 @@ def test_a_wall_touch_while_turning_leaves_the_airframe_upright() -> None:
     sensors = rig.af.sensors()
     assert abs(sensors.roll) < math.radians(10) and abs(sensors.pitch) < math.radians(10)
     assert state.z > 0.8
+
+
+def test_a_steady_torque_is_worked_off_by_the_rate_integrators() -> None:
+    """A steady roll torque (a touch's friction, an off-centre load) leaves a P-only attitude loop leaning; the rate
+    loops' integrators (ATC_RAT_RLL_I, capped at ATC_RAT_RLL_IMAX) bring the airframe back to level."""
+    rig = Rig("ahead", 0).airborne()
+    push = 0.25  # N m about the body's x axis, held
+    rig.data.xfrc_applied[rig.af.body, 3] = push
+    rig.run(0.3)
+    early = abs(rig.af.sensors().roll)
+    rig.run(3.0)
+    late = abs(rig.af.sensors().roll)
+    assert early > math.radians(2.0)  # the torque does lean it at first
+    assert late < 0.25 * early and late < math.radians(1.0)
+    assert rig.af.state.crashes == 0 and rig.af.fc.armed
