@@ -99,7 +99,7 @@ class ColourMask:
         """The full-resolution mask (with the exposure-adapted V bound), as the refinement sees it."""
         return self.clean(self.raw(image, self.bounds_for(image)))
 
-    def centre_share(self, image: MatLike, r: int, gain: float = 1.0) -> float:
+    def centre_share(self, image: MatLike, r: int, gain: float) -> float:
         """The share of the (2 r + 1)-pixel square at the frame's centre that is of the target's colour (with the
         frame's V bound ``gain`` times as high)."""
         h, w = image.shape[:2]

@@ -64,7 +64,7 @@ class Airframe:
         # full authority): a steady torque (a wall touch's friction, an off-centre load) is worked off
         self._ki = frame.rate_gain * params["ATC_RAT_RLL_I"] / params["ATC_RAT_RLL_P"]
         full = 2.0 * frame.motor_max_n * frame.arm_m / math.sqrt(2.0)  # torque of two motors' full thrust
-        self._i_max_x = self._i_max_y = params["ATC_RAT_RLL_IMAX"] * full
+        self._i_max = params["ATC_RAT_RLL_IMAX"] * full
         self._i_x = self._i_y = 0.0
         self._mixer = Mixer(frame.arm_m, frame.yaw_moment_m, params["MOT_SPIN_MIN"] * frame.motor_max_n,
                             frame.motor_max_n, params["MOT_YAW_HEADROOM"])
@@ -113,8 +113,8 @@ class Airframe:
             if self.fc.landed:
                 self._i_x = self._i_y = 0.0  # ArduCopter resets its rate integrators on the ground
             else:
-                self._i_x = min(max(self._i_x + ix * self._ki * err_x * dt, -self._i_max_x), self._i_max_x)
-                self._i_y = min(max(self._i_y + iy * self._ki * err_y * dt, -self._i_max_y), self._i_max_y)
+                self._i_x = min(max(self._i_x + ix * self._ki * err_x * dt, -self._i_max), self._i_max)
+                self._i_y = min(max(self._i_y + iy * self._ki * err_y * dt, -self._i_max), self._i_max)
             wrench = (demand.collective * 4.0 * frame.motor_max_n,
                       ix * gain * err_x + self._i_x,
                       iy * gain * err_y + self._i_y,

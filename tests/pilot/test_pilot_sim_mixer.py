@@ -6,19 +6,18 @@ from __future__ import annotations
 import math
 
 import pytest
-from sim_rig import CH, Rig
+from sim_rig import CH, PARAMS, Rig
 
-from pilot.sim import rc
 from pilot.sim.mixer import Mixer
 from pilot.sim.scene import MOTOR_SPIN, motor_positions
 
-FRAME = rc.load().airframe
-FLOOR = 0.15 * FRAME.motor_max_n
+FRAME = PARAMS.airframe
+FLOOR = PARAMS["MOT_SPIN_MIN"] * FRAME.motor_max_n
 TOP = FRAME.motor_max_n
 HOVER = FRAME.mass_kg * 9.81
 
 
-def mixer(headroom: float = 200.0) -> Mixer:
+def mixer(headroom: float = PARAMS["MOT_YAW_HEADROOM"]) -> Mixer:
     return Mixer(FRAME.arm_m, FRAME.yaw_moment_m, FLOOR, TOP, headroom)
 
 
@@ -51,7 +50,7 @@ def test_a_yaw_demand_past_the_motors_authority_leaves_roll_and_pitch_whole() ->
 def test_the_yaw_headroom_is_kept_even_when_roll_and_pitch_take_everything() -> None:
     full_roll = 10.0  # more than four motors can make: roll, pitch and yaw are scaled down together
     without = wrench(mixer(0.0).thrusts(HOVER, full_roll, 0.0, 1.0))
-    kept = wrench(mixer(200.0).thrusts(HOVER, full_roll, 0.0, 1.0))
+    kept = wrench(mixer().thrusts(HOVER, full_roll, 0.0, 1.0))
     assert without[3] == pytest.approx(0.0, abs=1e-9) and kept[3] > 0.0
     assert 0.0 < kept[1] < full_roll
 
