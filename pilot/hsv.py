@@ -100,6 +100,7 @@ SECOND_LOOK_MIN = 0.75  # ...keeps what scores this: a fallback needs stronger e
 NEAR_GAIN = 0.5  # a tracked ball's closer look: the V bound this much lower...
 NEAR_MARGIN = 0.1  # ...in a window this share of the frame's width wider than the ball on each side
 RIM_STEP = 2.0  # px outwards from a contour point where the unopened mask must be unset for a real edge
+SCORES_KEPT = 64  # blob scores remembered at most (a frame scores a handful)
 AIM_SPAN, AIM_SHARE = 0.35, 0.8  # the aim point's window (of the ball's diameter), and its share of target colour
 
 
@@ -123,6 +124,7 @@ class HsvBlobDetector:
         self.vision = vision or VisionConfig()
         self.fov_deg = fov_deg
         self._width = 320  # of the frame being looked at (range estimates)
+        self._scores: dict[int, tuple[Features, int, float]] = {}  # id -> the blob (kept alive), width, score
 
     @property
     def single_range(self) -> bool:
@@ -139,14 +141,16 @@ class HsvBlobDetector:
         nothing scoring ``SECOND_LOOK_UNLESS``."""
         w, h = frame_size(image)
         self._width = w
+        self._scores.clear()
         scale = 2 if w >= SEARCH_MIN_WIDTH else 1
         small = cv2.resize(image, (w // scale, h // scale), interpolation=cv2.INTER_AREA) if scale > 1 else image
         bounds = self.colour.bounds_for(small)  # the exposure read where the resize has just been: in cache
         small_hsv = cv2.cvtColor(small, self.colour.code)
         found = self._look(image, bounds, small_hsv, scale)
+        if any(self.score(f, w) >= SECOND_LOOK_UNLESS for f in found):
+            return found
         lower = darker(bounds, SECOND_LOOK_GAIN)
-        lowered = any(int(a[0][2]) != int(b[0][2]) for a, b in zip(lower, bounds, strict=True))  # not at the floor
-        if lowered and not any(self.score(f, w) >= SECOND_LOOK_UNLESS for f in found):
+        if any(int(a[0][2]) != int(b[0][2]) for a, b in zip(lower, bounds, strict=True)):  # not at the floor
             more = self._look(image, lower, small_hsv, scale, splits=False)
             found += [f for f in more if _new(f, found) and self.score(f, w) >= SECOND_LOOK_MIN]
         return found
@@ -180,10 +184,12 @@ class HsvBlobDetector:
         found: list[Features] = []
         for area, c, (x, y, bw, bh) in boxes[:MAX_CANDIDATES]:
             across = max(bw, bh) * scale if scale > 1 else 0  # searched at full resolution: refined as it is
-            half = self._measure(small_hsv, mask, c, area, 0, 0, scale=scale) if across >= HALF_TRY else None
-            if across >= HALF_MEASURE:
+            # below HALF_MEASURE, the look at half resolution counts only if it decides (and stops when it cannot)
+            decide = across < HALF_MEASURE
+            half = self._measure(small_hsv, mask, c, area, 0, 0, scale, decide=decide) if across >= HALF_TRY else None
+            if not decide:
                 fs = [] if half is None else [half]
-            elif half and half.fill >= HALF_FILL and half.arc >= HALF_ARC and self.score(half, w) >= HALF_DECIDES:
+            elif half is not None and self.score(half, w) >= HALF_DECIDES:
                 fs = [half]
             else:
                 fs = self._refine(image, bounds, (x * scale, y * scale, bw * scale, bh * scale))
@@ -301,25 +307,26 @@ class HsvBlobDetector:
         return None if f is None else f._replace(cx=piece.cx + x0, cy=piece.cy + y0, size=2.0 * piece.radius + 1.0)
 
     def _measure(self, hsv: MatLike, mask: MatLike, c: MatLike, area: float, x0: int, y0: int,
-                 scale: int = 1, cut: bool = False) -> Features | None:
+                 scale: int = 1, cut: bool = False, decide: bool = False) -> Features | None:
         """The blob's features; None as soon as the product of its factors so far is below ``min_score``.
         ``scale``: the mask is the search's, that many times smaller than the frame; ``cut``: the blob is a piece
-        an opening left, and only its outline on the mask's real edge counts for its arcs."""
+        an opening left, and only its outline on the mask's real edge counts for its arcs; ``decide``: None too as
+        soon as it cannot be a plain disc scoring ``HALF_DECIDES`` (``HALF_FILL``, ``HALF_ARC``)."""
+        least = max(self.cfg.min_score, HALF_DECIDES) if decide else self.cfg.min_score
         (cx, cy), r = cv2.minEnclosingCircle(c)
         # the circle passes through pixel centres; the ball covers the pixels. At half resolution: 4 r, between a
         # flat disc's 4 r - 1.7 and a shaded ball's 4 r + 1 (tuning photos; the flights' approach rests on it)
         size = 2.0 * r * scale + 1.0 - (scale - 1)
+        fill = area / (math.pi * r * r) if r > 0 else 0.0
+        # the factors in the order that rejects soonest for least (bench/vision's frames): size and fill from the
+        # circle alone, then elongation, then the arcs (what most blobs that get that far fail), then the ring
+        geometry = self._size_score(size, self._width) * ramp(fill, *FILL)
+        if geometry <= 0.0 or geometry < least or (decide and fill < HALF_FILL):
+            return None
         (_, _), (rw, rh), _ = cv2.minAreaRect(c)
         elongation = max(rw, rh) / max(1e-6, min(rw, rh))
-        fill = area / (math.pi * r * r) if r > 0 else 0.0
-        geometry = self._size_score(size, self._width) * ramp(fill, *FILL)
         geometry *= ramp(elongation, *ELONGATION)
-        if geometry <= 0.0 or geometry < self.cfg.min_score:
-            return None
-        # the ring from 1.25 to 1.75 radii, sampled: outside the blob's circle, so the mask there is something else
-        ring = share_set(mask, cx, cy, RING_POINTS, max(r, 2.0))
-        geometry *= ramp(ring, *RING)
-        if geometry <= 0.0 or geometry < self.cfg.min_score:
+        if geometry <= 0.0 or geometry < least:
             return None
         pts = c.reshape(-1, 2)
         d2 = np.square(pts - (cx, cy)).sum(axis=1)
@@ -331,11 +338,21 @@ class HsvBlobDetector:
         arc = float(np.count_nonzero(on_arc)) / len(pts)
         # an ellipse no longer than ELLIPSE_ASPECT fills 1 / ELLIPSE_ASPECT of its enclosing circle or more: a blob
         # filling less has something sticking out (a red lamp on the tuning photos' motorbike passed as an ellipse)
-        ellipse_arc = ellipse_support(pts, real) if arc < ARC[1] and fill >= 1.0 / ELLIPSE_ASPECT else 0.0
+        if decide and arc < HALF_ARC:
+            return None
+        may_be_ellipse = arc < ARC[1] and fill >= 1.0 / ELLIPSE_ASPECT
+        if not may_be_ellipse and geometry * ramp(arc, *ARC) < least:
+            return None
+        # the ring from 1.25 to 1.75 radii, sampled: outside the blob's circle, so the mask there is something else
+        ring = share_set(mask, cx, cy, RING_POINTS, max(r, 2.0))
+        geometry *= ramp(ring, *RING)
+        if geometry <= 0.0 or geometry < least:
+            return None
+        ellipse_arc = ellipse_support(pts, real) if may_be_ellipse else 0.0
         hull = float(cv2.contourArea(cv2.convexHull(c)))
         solidity = area / hull if hull > 0 else 0.0
         geometry *= arc_score(arc, ellipse_arc) * ramp(solidity, *SOLIDITY)
-        if geometry <= 0.0 or geometry < self.cfg.min_score:
+        if geometry <= 0.0 or geometry < least:
             return None
         # colour: the mean over the blob's box (the mask's pixels there are the blob's, or nearly)
         bx, by, bw, bh = cv2.boundingRect(c)
@@ -354,6 +371,17 @@ class HsvBlobDetector:
         return ramp(size, *SIZE)
 
     def score(self, f: Features, width: int) -> float:
+        """0..1 (a frame asks it three or four times of one blob: remembered until the next frame's look)."""
+        known = self._scores.get(id(f))
+        if known is not None and known[0] is f and known[1] == width:
+            return known[2]
+        s = self._score(f, width)
+        if len(self._scores) >= SCORES_KEPT:
+            self._scores.clear()
+        self._scores[id(f)] = (f, width, s)
+        return s
+
+    def _score(self, f: Features, width: int) -> float:
         shape = arc_score(f.arc, f.ellipse_arc) * ramp(f.solidity, *SOLIDITY) * ramp(f.fill, *FILL)
         shape *= ramp(f.elongation, *ELONGATION) * self._size_score(f.size, width)
         colour = ramp(f.saturation, self.colour.sat_lo + SATURATION[0], self.colour.sat_lo + SATURATION[1])

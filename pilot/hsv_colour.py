@@ -17,7 +17,7 @@ from cv2.typing import MatLike
 from .config import HsvConfig
 from .errors import ConfigError
 
-V_REFERENCE = 200.0  # brightness (see exposure) of a well-exposed frame; the V bound scales below it
+V_REFERENCE = 200  # brightness (see exposure) of a well-exposed frame; the V bound scales below it
 V_FLOOR = 24  # the V bound never drops below this: under it hue and saturation are noise
 
 Bounds = list[tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]]  # inRange's lower and upper HSV triples
@@ -74,8 +74,11 @@ class ColourMask:
         """The ranges with the V bound for this frame's exposure: a high order statistic of every channel on a
         sparse grid (a few µs)."""
         step = max(4, image.shape[1] // 24)  # about 24x18 samples at any frame size
-        grid = np.asarray(image[::step, ::step]).reshape(-1)
-        k = max(1, grid.size // 50)  # the 98th percentile, without a sort
+        view = image[::step, ::step]
+        k = max(1, view.size // 50)  # the 98th percentile, without a sort
+        if np.count_nonzero(view >= V_REFERENCE) >= k:  # at least the reference: the configured bound (most frames)
+            return self.ranges
+        grid = np.asarray(view).reshape(-1)
         gain = min(1.0, float(np.partition(grid, grid.size - k)[grid.size - k]) / V_REFERENCE)
         return self.ranges if gain >= 1.0 else darker(self.ranges, gain)
 
