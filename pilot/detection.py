@@ -7,6 +7,7 @@ import math
 from dataclasses import dataclass
 from typing import Protocol
 
+import numpy as np
 from cv2.typing import MatLike
 
 
@@ -19,6 +20,19 @@ class FrameStatus(enum.Enum):
     BLACK = "black"
     SATURATED = "saturated"
     FROZEN = "frozen"  # the same pixels frame after frame: the camera has stopped
+
+
+MIN_WIDTH, MIN_HEIGHT = 32, 24  # a smaller frame has too few pixels to show any target's shape
+
+
+def malformed(image: object) -> FrameStatus | None:
+    """WRONG_TYPE or WRONG_SHAPE when ``image`` is no frame a detector can look at (an 8-bit, 3-channel image at
+    least MIN_WIDTH x MIN_HEIGHT), else None."""
+    if not isinstance(image, np.ndarray) or image.dtype != np.uint8:
+        return FrameStatus.WRONG_TYPE
+    if image.ndim != 3 or image.shape[2] != 3 or image.shape[1] < MIN_WIDTH or image.shape[0] < MIN_HEIGHT:
+        return FrameStatus.WRONG_SHAPE
+    return None
 
 
 @dataclass(frozen=True)
@@ -99,8 +113,13 @@ def frame_size(image: MatLike) -> tuple[int, int]:
 
 
 def best_detection(source: CandidateSource, image: MatLike, object_m: float, horizontal_fov_deg: float) -> Detection:
-    """This frame alone, the source's best candidate (no tracking, no frame checks: see
-    ``pilot.detect.make_detector``), with its pinhole range for an object ``object_m`` across."""
+    """This frame alone, the source's best candidate (no tracking, none of the black, saturated or frozen frame
+    checks: see ``pilot.detect.make_detector``), with its pinhole range for an object ``object_m`` across. A frame
+    that is not an 8-bit 3-channel image of a usable size gets its status, not an OpenCV error."""
+    shape: tuple[int, ...] = tuple(getattr(image, "shape", ()))
+    if (status := malformed(image)) is not None:
+        return Detection(False, width=int(shape[1]) if len(shape) >= 2 else 0,
+                         height=int(shape[0]) if shape else 0, status=status)
     w, h = frame_size(image)
     cands = source.candidates(image)
     if not cands:

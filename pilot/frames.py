@@ -10,9 +10,8 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from .detection import FrameStatus
+from .detection import FrameStatus, malformed
 
-MIN_WIDTH, MIN_HEIGHT = 32, 24
 BLACK_LEVEL = 12  # brightest channel at or below this: black
 SATURATED_LEVEL = 250  # darkest channel at or above this: blown out
 DEAD_SHARE = 0.98  # share of the grid that must be black (or saturated) for the frame to be
@@ -26,12 +25,11 @@ class FrameCheck:
         self._repeats = 0
 
     def check(self, image: object) -> FrameStatus:
-        if not isinstance(image, np.ndarray) or image.dtype != np.uint8:
-            return FrameStatus.WRONG_TYPE
-        if image.ndim != 3 or image.shape[2] != 3:
-            return FrameStatus.WRONG_SHAPE
+        if (bad := malformed(image)) is not None:
+            return bad
+        assert isinstance(image, np.ndarray)  # malformed() made sure; for the type checker
         h, w = image.shape[:2]
-        if w < MIN_WIDTH or h < MIN_HEIGHT or (self.size is not None and self.size != (w, h)):
+        if self.size is not None and self.size != (w, h):
             return FrameStatus.WRONG_SHAPE
         step = max(2, w // 32)
         grid: npt.NDArray[np.uint8] = image[::step, ::step].copy()

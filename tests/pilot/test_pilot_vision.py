@@ -36,6 +36,24 @@ def test_bad_frames_are_named_and_never_found(image: object, status: FrameStatus
     assert det.status is status and not det.found
 
 
+@pytest.mark.parametrize(
+    "image,status",
+    [
+        (np.zeros((240, 320), np.uint8) + 100, FrameStatus.WRONG_SHAPE),
+        (np.zeros((240, 320, 4), np.uint8) + 100, FrameStatus.WRONG_SHAPE),
+        (np.zeros((8, 8, 3), np.uint8) + 100, FrameStatus.WRONG_SHAPE),
+        (np.zeros((0, 0, 3), np.uint8), FrameStatus.WRONG_SHAPE),
+        (np.zeros((240, 320, 3), np.float32) + 100, FrameStatus.WRONG_TYPE),
+        (None, FrameStatus.WRONG_TYPE),
+    ],
+)
+def test_single_frame_detectors_name_malformed_frames(image: object, status: FrameStatus) -> None:
+    """The single-frame ``detect`` (no tracking) answers a malformed frame with its status, not an OpenCV error."""
+    for det in (HsvBlobDetector(), ArucoMarkerDetector()):
+        out = det.detect(image)  # type: ignore[arg-type]
+        assert out.status is status and not out.found, det.name
+
+
 def test_frozen_camera_and_size_change() -> None:
     det = make_detector(PilotConfig())
     rng = np.random.default_rng(0)
