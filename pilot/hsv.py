@@ -43,6 +43,12 @@ high, keeping what scores ``SECOND_LOOK_MIN``: a ball's shaded side, or a ball i
 the bound (a lower bound for every frame joined dark red-brown surfaces to the balls on the tuning photos; steps 3
 and 4 in it too found a few balls more for 0.15x the floor more in bench/vision's median).
 
+A frame where nothing scores ``SECOND_LOOK_UNLESS`` after both looks gets a rim look (pilot/hsv_measure.py): the
+blobs that their arcs or ring held down are measured again with their rim support (pilot/hsv_rim.py), a brightness
+edge all round them, which stands in for the arcs (a mask frayed by JPEG's colour blocks, noise or shade) and for
+isolation (a ball on a surface of its colour). Pieces cut by edges under ``hsv_edges.MIN_SIZE`` count with a rim
+of ``SMALL_RIM``.
+
 A tracked ball the frame's look misses gets a closer look where the track expects it (``candidates_near``, called
 by pilot/detect.py): that window refined with the V bound ``NEAR_GAIN`` times as high.
 
@@ -59,24 +65,12 @@ import numpy as np
 from cv2.typing import MatLike
 
 from .config import HsvConfig, VisionConfig
-from .detection import Candidate, Detection, best_detection, frame_size, range_of
-from .hsv_colour import Bounds, ColourMask, darker
+from .detection import Candidate, Detection, best_detection, frame_size
+from .hsv_colour import Bounds, darker
 from .hsv_edges import MIN_SIZE, WALL_GROWTH, cut_by_edges, walled_in
-from .hsv_score import (
-    ARC,
-    ARC_TOL,
-    ELONGATION,
-    FILL,
-    HUE_OFF,
-    RING,
-    SATURATION,
-    SIZE,
-    SOLIDITY,
-    Features,
-    arc_score,
-    ramp,
-)
-from .hsv_shape import ELLIPSE_ASPECT, RING_POINTS, ellipse_support, outer_rim, share_set
+from .hsv_measure import HALF_DECIDES, BlobMeasure
+from .hsv_rim import rim_support
+from .hsv_score import SIZE, Features
 from .hsv_split import disc_centres, hue_split, round_pieces, split_off
 
 MAX_CANDIDATES = 4  # the largest search blobs refined; smaller ones cannot be the nearest target
@@ -89,18 +83,16 @@ SPLIT_BLOBS = 3  # the largest such blobs searched for discs
 SPLIT_PEAKS = 4  # disc centres refined per frame, widest first
 HUE_PIECES = 2  # the largest round pieces of each hue class refined
 EDGE_BLOBS = 2  # the largest search blobs cut by the image's edges
-HALF_TRY = 24  # px across: a smaller search blob is only refined
-HALF_DECIDES = 0.9  # the half-resolution score that keeps a blob from the refinement...
-HALF_FILL = 0.8  # ...for a plain disc only: this fill of its circle (a square's is 0.64)...
-HALF_ARC = 0.8  # ...and this share of its outline on it
+HALF_TRY = 24  # px across: a smaller search blob is only refined; from this, first measured at half
+# resolution, where a plain disc scoring HALF_DECIDES (pilot/hsv_measure.py) skips the refinement
 SPLIT_UNLESS = 0.8  # a candidate scoring this already: no split (0.1-0.3 ms a disc or piece refined)
 SECOND_LOOK_UNLESS = 0.6  # nothing scoring this (the default acquisition threshold): a second look...
 SECOND_LOOK_GAIN = 0.8  # ...with the V bound this much lower (a ball's shaded side, a dim or backlit ball)...
 SECOND_LOOK_MIN = 0.75  # ...keeps what scores this: a fallback needs stronger evidence (tuning photos' empty views)
+RIM_LOOKS = 6  # blobs held down by their arcs or ring measured again with their rim, at most
+SMALL_RIM = 0.85  # a piece cut by edges under MIN_SIZE counts with this rim support (not texture)
 NEAR_GAIN = 0.5  # a tracked ball's closer look: the V bound this much lower...
 NEAR_MARGIN = 0.1  # ...in a window this share of the frame's width wider than the ball on each side
-RIM_STEP = 2.0  # px outwards from a contour point where the unopened mask must be unset for a real edge
-SCORES_KEPT = 64  # blob scores remembered at most (a frame scores a handful)
 AIM_SPAN, AIM_SHARE = 0.35, 0.8  # the aim point's window (of the ball's diameter), and its share of target colour
 
 
@@ -112,19 +104,13 @@ def _new(f: Features, found: list[Features]) -> bool:
     return all(abs(f.cx - g.cx) > 1.0 or abs(f.cy - g.cy) > 1.0 for g in found)
 
 
-class HsvBlobDetector:
+class HsvBlobDetector(BlobMeasure):
     name = "hsv"
 
     def __init__(
         self, config: HsvConfig | None = None, vision: VisionConfig | None = None, fov_deg: float = 60.0
     ) -> None:
-        cfg = config or HsvConfig()
-        self.colour = ColourMask(cfg)  # raises ConfigError without a range
-        self.cfg = cfg
-        self.vision = vision or VisionConfig()
-        self.fov_deg = fov_deg
-        self._width = 320  # of the frame being looked at (range estimates)
-        self._scores: dict[int, tuple[Features, int, float]] = {}  # id -> the blob (kept alive), width, score
+        super().__init__(config or HsvConfig(), vision or VisionConfig(), fov_deg)
 
     @property
     def single_range(self) -> bool:
@@ -140,24 +126,40 @@ class HsvBlobDetector:
         """Every refined blob's features (unscored): a second look with a lower V bound when the first found
         nothing scoring ``SECOND_LOOK_UNLESS``."""
         w, h = frame_size(image)
-        self._width = w
-        self._scores.clear()
+        self.new_frame(w)
         scale = 2 if w >= SEARCH_MIN_WIDTH else 1
         small = cv2.resize(image, (w // scale, h // scale), interpolation=cv2.INTER_AREA) if scale > 1 else image
         bounds = self.colour.bounds_for(small)  # the exposure read where the resize has just been: in cache
         small_hsv = cv2.cvtColor(small, self.colour.code)
-        found = self._look(image, bounds, small_hsv, scale)
+        found = self._look(image, bounds, small, small_hsv, scale)
         if any(self.score(f, w) >= SECOND_LOOK_UNLESS for f in found):
             return found
         lower = darker(bounds, SECOND_LOOK_GAIN)
         if any(int(a[0][2]) != int(b[0][2]) for a, b in zip(lower, bounds, strict=True)):  # not at the floor
-            more = self._look(image, lower, small_hsv, scale, splits=False)
+            self.keep_from = SECOND_LOOK_MIN
+            more = self._look(image, lower, small, small_hsv, scale, splits=False)
             found += [f for f in more if _new(f, found) and self.score(f, w) >= SECOND_LOOK_MIN]
+            if any(self.score(f, w) >= SECOND_LOOK_UNLESS for f in found):
+                return found
+        return self._rim_look(found)
+
+    def _rim_look(self, found: list[Features]) -> list[Features]:
+        """The blobs held down by their arcs or ring measured again with their rim support; each replaces its
+        first measure when it scores higher."""
+        w = self._width
+        for d in self.deferred[:RIM_LOOKS]:
+            f = self.measure(d.hsv, d.mask, d.contour, d.area, d.x0, d.y0, d.scale, bgr=d.bgr, rim=True)
+            if f is None or (s := self.score(f, w)) < d.keep_from:
+                continue
+            same = [g for g in found if not _new(f, [g])]
+            if all(s > self.score(g, w) for g in same):
+                found = [g for g in found if _new(f, [g])] + [f]
         return found
 
-    def _look(self, image: MatLike, bounds: Bounds, small_hsv: MatLike, scale: int,
+    def _look(self, image: MatLike, bounds: Bounds, small: MatLike, small_hsv: MatLike, scale: int,
               splits: bool = True) -> list[Features]:
-        """Steps 1 to 4 (without ``splits``, 1 and 2) with ``bounds``, on the search's HSV (``scale`` x smaller)."""
+        """Steps 1 to 4 (without ``splits``, 1 and 2) with ``bounds``, on the search (``small``, ``scale`` x
+        smaller, and its HSV)."""
         w = frame_size(image)[0]
         mask = self.colour.in_range(small_hsv, bounds)
         if self.colour.kernel is not None:
@@ -186,7 +188,8 @@ class HsvBlobDetector:
             across = max(bw, bh) * scale if scale > 1 else 0  # searched at full resolution: refined as it is
             # below HALF_MEASURE, the look at half resolution counts only if it decides (and stops when it cannot)
             decide = across < HALF_MEASURE
-            half = self._measure(small_hsv, mask, c, area, 0, 0, scale, decide=decide) if across >= HALF_TRY else None
+            half = self.measure(small_hsv, mask, c, area, 0, 0, scale, decide=decide,
+                                bgr=small) if across >= HALF_TRY else None
             if not decide:
                 fs = [] if half is None else [half]
             elif half is not None and self.score(half, w) >= HALF_DECIDES:
@@ -224,11 +227,13 @@ class HsvBlobDetector:
             for c, area in cut.pieces:
                 piece = np.zeros_like(np.asarray(mask))
                 cv2.drawContours(piece, [c], -1, 255, -1)
-                f = self._measure(hsv, piece, c, area, x0, y0)
+                f = self.measure(hsv, piece, c, area, x0, y0)
                 if f is None:
                     continue
                 f = f._replace(size=f.size + WALL_GROWTH, ring=1.0 - walled_in(cut.separated, c))
-                if f.size >= MIN_SIZE and _new(f, found + out):
+                if SIZE[1] <= f.size < MIN_SIZE:  # a small piece: a bit of texture unless a brightness edge all round
+                    f = f._replace(rim=rim_support(roi, f.cx - x0, f.cy - y0, (f.size - 1.0) / 2.0))
+                if (f.size >= MIN_SIZE or (f.size >= SIZE[1] and f.rim >= SMALL_RIM)) and _new(f, found + out):
                     out.append(f)
         return out
 
@@ -284,11 +289,11 @@ class HsvBlobDetector:
         bx, by, bw, bh = box
         pad = max(bw, bh) // 2 + 4  # a ring reaches 1.75 radii; the search rounds by a pixel or two
         x0, y0 = max(0, bx - pad), max(0, by - pad)
-        _, hsv, mask = self._window(image, bounds, x0, y0, min(w, bx + bw + pad), min(h, by + bh + pad))
+        roi, hsv, mask = self._window(image, bounds, x0, y0, min(w, bx + bw + pad), min(h, by + bh + pad))
         contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
         blobs = [(a, c) for c in contours if len(c) >= 8 and (a := float(cv2.contourArea(c))) >= self.cfg.min_area]
         blobs.sort(key=lambda b: b[0], reverse=True)
-        found = (self._measure(hsv, mask, c, area, x0, y0) for area, c in blobs[:BLOBS_PER_BOX])
+        found = (self.measure(hsv, mask, c, area, x0, y0, bgr=roi) for area, c in blobs[:BLOBS_PER_BOX])
         return [f for f in found if f is not None]
 
     def _refine_disc(self, image: MatLike, bounds: Bounds, px: float, py: float, r: float) -> Features | None:
@@ -302,91 +307,9 @@ class HsvBlobDetector:
         if piece is None:
             return None
         # the ring on the unopened mask: what the opening cut off is still around the ball
-        f = self._measure(hsv, mask, piece.contour, piece.area, x0, y0, cut=True)
+        f = self.measure(hsv, mask, piece.contour, piece.area, x0, y0, cut=True)
         # the widest disc gives the position and size (a drawn disc 2 R + 1 px across reads R at its centre)
         return None if f is None else f._replace(cx=piece.cx + x0, cy=piece.cy + y0, size=2.0 * piece.radius + 1.0)
-
-    def _measure(self, hsv: MatLike, mask: MatLike, c: MatLike, area: float, x0: int, y0: int,
-                 scale: int = 1, cut: bool = False, decide: bool = False) -> Features | None:
-        """The blob's features; None as soon as the product of its factors so far is below ``min_score``.
-        ``scale``: the mask is the search's, that many times smaller than the frame; ``cut``: the blob is a piece
-        an opening left, and only its outline on the mask's real edge counts for its arcs; ``decide``: None too as
-        soon as it cannot be a plain disc scoring ``HALF_DECIDES`` (``HALF_FILL``, ``HALF_ARC``)."""
-        least = max(self.cfg.min_score, HALF_DECIDES) if decide else self.cfg.min_score
-        (cx, cy), r = cv2.minEnclosingCircle(c)
-        # the circle passes through pixel centres; the ball covers the pixels. At half resolution: 4 r, between a
-        # flat disc's 4 r - 1.7 and a shaded ball's 4 r + 1 (tuning photos; the flights' approach rests on it)
-        size = 2.0 * r * scale + 1.0 - (scale - 1)
-        fill = area / (math.pi * r * r) if r > 0 else 0.0
-        # the factors in the order that rejects soonest for least (bench/vision's frames): size and fill from the
-        # circle alone, then elongation, then the arcs (what most blobs that get that far fail), then the ring
-        geometry = self._size_score(size, self._width) * ramp(fill, *FILL)
-        if geometry <= 0.0 or geometry < least or (decide and fill < HALF_FILL):
-            return None
-        (_, _), (rw, rh), _ = cv2.minAreaRect(c)
-        elongation = max(rw, rh) / max(1e-6, min(rw, rh))
-        geometry *= ramp(elongation, *ELONGATION)
-        if geometry <= 0.0 or geometry < least:
-            return None
-        pts = c.reshape(-1, 2)
-        d2 = np.square(pts - (cx, cy)).sum(axis=1)
-        tol = max(1.5, ARC_TOL * r)
-        on_arc = (d2 >= (r - tol) ** 2) & (d2 <= (r + tol) ** 2)
-        real = outer_rim(mask, pts, cx, cy, RIM_STEP) if cut else None
-        if real is not None:
-            on_arc &= real
-        arc = float(np.count_nonzero(on_arc)) / len(pts)
-        # an ellipse no longer than ELLIPSE_ASPECT fills 1 / ELLIPSE_ASPECT of its enclosing circle or more: a blob
-        # filling less has something sticking out (a red lamp on the tuning photos' motorbike passed as an ellipse)
-        if decide and arc < HALF_ARC:
-            return None
-        may_be_ellipse = arc < ARC[1] and fill >= 1.0 / ELLIPSE_ASPECT
-        if not may_be_ellipse and geometry * ramp(arc, *ARC) < least:
-            return None
-        # the ring from 1.25 to 1.75 radii, sampled: outside the blob's circle, so the mask there is something else
-        ring = share_set(mask, cx, cy, RING_POINTS, max(r, 2.0))
-        geometry *= ramp(ring, *RING)
-        if geometry <= 0.0 or geometry < least:
-            return None
-        ellipse_arc = ellipse_support(pts, real) if may_be_ellipse else 0.0
-        hull = float(cv2.contourArea(cv2.convexHull(c)))
-        solidity = area / hull if hull > 0 else 0.0
-        geometry *= arc_score(arc, ellipse_arc) * ramp(solidity, *SOLIDITY)
-        if geometry <= 0.0 or geometry < least:
-            return None
-        # colour: the mean over the blob's box (the mask's pixels there are the blob's, or nearly)
-        bx, by, bw, bh = cv2.boundingRect(c)
-        box = (slice(by, by + bh), slice(bx, bx + bw))
-        mean = cv2.mean(hsv[box], mask=mask[box])
-        half = (scale - 1) / 2.0  # a pixel's centre at half resolution lies between two at full resolution
-        return Features(
-            (cx + x0) * scale + half, (cy + y0) * scale + half, size, arc, solidity, fill, elongation,
-            float(mean[1]), abs(float(mean[0]) - self.colour.hue_mid) / self.colour.hue_half, ring, ellipse_arc,
-        )
-
-    def _size_score(self, size: float, width: int) -> float:
-        distance = range_of(size, self.cfg.target_diameter_m, width, self.fov_deg)
-        if not self.vision.range_min_m <= distance <= self.vision.range_max_m:
-            return 0.0
-        return ramp(size, *SIZE)
-
-    def score(self, f: Features, width: int) -> float:
-        """0..1 (a frame asks it three or four times of one blob: remembered until the next frame's look)."""
-        known = self._scores.get(id(f))
-        if known is not None and known[0] is f and known[1] == width:
-            return known[2]
-        s = self._score(f, width)
-        if len(self._scores) >= SCORES_KEPT:
-            self._scores.clear()
-        self._scores[id(f)] = (f, width, s)
-        return s
-
-    def _score(self, f: Features, width: int) -> float:
-        shape = arc_score(f.arc, f.ellipse_arc) * ramp(f.solidity, *SOLIDITY) * ramp(f.fill, *FILL)
-        shape *= ramp(f.elongation, *ELONGATION) * self._size_score(f.size, width)
-        colour = ramp(f.saturation, self.colour.sat_lo + SATURATION[0], self.colour.sat_lo + SATURATION[1])
-        colour *= 1.0 - ramp(f.hue_off, *HUE_OFF)
-        return shape * colour * ramp(f.ring, *RING)
 
     def candidates(self, image: MatLike) -> list[Candidate]:
         width = frame_size(image)[0]

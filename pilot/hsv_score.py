@@ -14,6 +14,7 @@ ELONGATION = (2.0, 1.4)  # minimum-area rectangle, longer side over shorter (fal
 SATURATION = (10.0, 60.0)  # mean saturation above the S bound (pink and pale red sit just over it)
 HUE_OFF = (0.6, 1.0)  # mean hue's distance from the range's middle, in half-widths
 RING = (0.35, 0.1)  # share of the ring of the target's colour (falling ramp)
+RIM = (0.7, 0.9)  # the rim's share that is a brightness edge (pilot/hsv_rim.py): a ball's is 0.8-1.0 whatever its mask
 SIZE = (8.0, 16.0)  # diameter, pixels: a smaller blob has too few pixels to show its shape
 
 
@@ -31,6 +32,7 @@ class Features(NamedTuple):
     hue_off: float  # mean hue's distance from the range's middle, in half-widths
     ring: float  # the ring's share of the target's colour (a piece cut by edges: its rim's share not walled in)
     ellipse_arc: float  # 0 where the circle's arc was enough (it is measured only below ARC's one)
+    rim: float  # the rim support (pilot/hsv_rim.py), 0 unless the frame's rim look measured it
 
 
 def ramp(value: float, zero: float, one: float) -> float:

@@ -1,0 +1,176 @@
+"""How the colour-ball detector (pilot/hsv.py) measures one blob and scores it: the features of ``Features``,
+measured in the order that rejects soonest for least, and the score, a product of ramps (pilot/hsv_score.py).
+
+A blob whose arcs or ring hold its score down, measured with the window's pixels at hand, is remembered for the
+frame (``deferred``): if the frame's looks find nothing the pilot would act on, the detector measures those again
+with their rim support (pilot/hsv_rim.py), which stands in for the arcs and for isolation. The rim costs more
+than everything else measured (about 60 µs), and a frame with a plain ball never needs it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import cv2
+import numpy as np
+from cv2.typing import MatLike
+
+from .config import HsvConfig, VisionConfig
+from .detection import range_of
+from .hsv_colour import ColourMask
+from .hsv_rim import rim_support
+from .hsv_score import (
+    ARC,
+    ARC_TOL,
+    ELONGATION,
+    FILL,
+    HUE_OFF,
+    RIM,
+    RING,
+    SATURATION,
+    SIZE,
+    SOLIDITY,
+    Features,
+    arc_score,
+    ramp,
+)
+from .hsv_shape import ELLIPSE_ASPECT, RING_POINTS, ellipse_support, outer_rim, share_set
+
+HALF_DECIDES = 0.9  # the half-resolution score that keeps a blob from the refinement...
+HALF_FILL = 0.8  # ...for a plain disc only: this fill of its circle (a square's is 0.64)...
+HALF_ARC = 0.8  # ...and this share of its outline on it
+RIM_STEP = 2.0  # px outwards from a contour point where the unopened mask must be unset for a real edge
+RIM_MIN_R = 7.0  # px (radius, in the measured image): a smaller circle has too few distinct rim pixels
+SCORES_KEPT = 64  # blob scores remembered at most (a frame scores a handful)
+
+
+class Deferred(NamedTuple):
+    """A blob to measure again with its rim: what ``measure`` was given, and the score it must reach then (the
+    look's: a fallback look asks for more)."""
+
+    hsv: MatLike
+    mask: MatLike
+    contour: MatLike
+    area: float
+    x0: int
+    y0: int
+    scale: int
+    bgr: MatLike
+    keep_from: float
+
+
+class BlobMeasure:
+    def __init__(self, cfg: HsvConfig, vision: VisionConfig, fov_deg: float) -> None:
+        self.colour = ColourMask(cfg)  # raises ConfigError without a range
+        self.cfg = cfg
+        self.vision = vision
+        self.fov_deg = fov_deg
+        self._width = 320  # of the frame being looked at (range estimates)
+        self._scores: dict[int, tuple[Features, int, float]] = {}  # id -> the blob (kept alive), width, score
+        self.deferred: list[Deferred] = []  # this frame's blobs held down by their arcs or ring
+        self.keep_from = 0.0  # the score a deferred blob must reach (a fallback look asks for more)
+
+    def new_frame(self, width: int) -> None:
+        self._width = width
+        self._scores.clear()
+        self.deferred.clear()
+        self.keep_from = 0.0
+
+    def measure(self, hsv: MatLike, mask: MatLike, c: MatLike, area: float, x0: int, y0: int, scale: int = 1,
+                cut: bool = False, decide: bool = False, bgr: MatLike | None = None,
+                rim: bool = False) -> Features | None:
+        """The blob's features; None as soon as the product of its factors so far is below ``min_score``.
+        ``scale``: the mask is the search's, that many times smaller than the frame; ``cut``: the blob is a piece
+        an opening left, and only its outline on the mask's real edge counts for its arcs; ``decide``: None too as
+        soon as it cannot be a plain disc scoring ``HALF_DECIDES`` (``HALF_FILL``, ``HALF_ARC``); ``bgr``: the
+        pixels of ``hsv``, to defer a blob held down by its arcs or ring; ``rim``: measure its rim now."""
+        least = max(self.cfg.min_score, HALF_DECIDES) if decide else self.cfg.min_score
+        (cx, cy), r = cv2.minEnclosingCircle(c)
+        # the circle passes through pixel centres; the ball covers the pixels. At half resolution: 4 r, between a
+        # flat disc's 4 r - 1.7 and a shaded ball's 4 r + 1 (tuning photos; the flights' approach rests on it)
+        size = 2.0 * r * scale + 1.0 - (scale - 1)
+        fill = area / (math.pi * r * r) if r > 0 else 0.0
+        # the factors in the order that rejects soonest for least (bench/vision's frames): size and fill from the
+        # circle alone, then elongation, then the arcs (what most blobs that get that far fail), then the ring
+        geometry = self._size_score(size, self._width) * ramp(fill, *FILL)
+        if geometry <= 0.0 or geometry < least or (decide and fill < HALF_FILL):
+            return None
+        (_, _), (rw, rh), _ = cv2.minAreaRect(c)
+        elongation = max(rw, rh) / max(1e-6, min(rw, rh))
+        geometry *= ramp(elongation, *ELONGATION)
+        if geometry <= 0.0 or geometry < least:
+            return None
+        later = None if bgr is None or rim or decide or r < RIM_MIN_R else Deferred(
+            hsv, mask, c, area, x0, y0, scale, bgr, max(least, self.keep_from))
+        edge = rim_support(bgr, cx, cy, r) if rim and bgr is not None else 0.0
+        pts = c.reshape(-1, 2)
+        d2 = np.square(pts - (cx, cy)).sum(axis=1)
+        tol = max(1.5, ARC_TOL * r)
+        on_arc = (d2 >= (r - tol) ** 2) & (d2 <= (r + tol) ** 2)
+        real = outer_rim(mask, pts, cx, cy, RIM_STEP) if cut else None
+        if real is not None:
+            on_arc &= real
+        arc = float(np.count_nonzero(on_arc)) / len(pts)
+        if decide and arc < HALF_ARC:
+            return None
+        # an ellipse no longer than ELLIPSE_ASPECT fills 1 / ELLIPSE_ASPECT of its enclosing circle or more: a blob
+        # filling less has something sticking out (a red lamp on the tuning photos' motorbike passed as an ellipse)
+        may_be_ellipse = arc < ARC[1] and fill >= 1.0 / ELLIPSE_ASPECT
+        if not may_be_ellipse and geometry * max(ramp(arc, *ARC), ramp(edge, *RIM)) < least:
+            self._defer(later)
+            return None
+        # the ring from 1.25 to 1.75 radii, sampled: outside the blob's circle, so the mask there is something else;
+        # a rim all round walls the blob off from what is there (a ball on a surface of its colour)
+        ring = min(share_set(mask, cx, cy, RING_POINTS, max(r, 2.0)), 1.0 - edge)
+        geometry *= ramp(ring, *RING)
+        if geometry <= 0.0 or geometry < least:
+            self._defer(later)
+            return None
+        ellipse_arc = ellipse_support(pts, real) if may_be_ellipse else 0.0
+        hull = float(cv2.contourArea(cv2.convexHull(c)))
+        solidity = area / hull if hull > 0 else 0.0
+        shape = max(arc_score(arc, ellipse_arc), ramp(edge, *RIM))
+        if shape < 1.0 or ring > RING[1]:
+            self._defer(later)  # held down by its arcs or ring, whether or not it passes
+        geometry *= shape * ramp(solidity, *SOLIDITY)
+        if geometry <= 0.0 or geometry < least:
+            return None
+        # colour: the mean over the blob's box (the mask's pixels there are the blob's, or nearly)
+        bx, by, bw, bh = cv2.boundingRect(c)
+        box = (slice(by, by + bh), slice(bx, bx + bw))
+        mean = cv2.mean(hsv[box], mask=mask[box])
+        half = (scale - 1) / 2.0  # a pixel's centre at half resolution lies between two at full resolution
+        return Features(
+            (cx + x0) * scale + half, (cy + y0) * scale + half, size, arc, solidity, fill, elongation,
+            float(mean[1]), abs(float(mean[0]) - self.colour.hue_mid) / self.colour.hue_half, ring, ellipse_arc,
+            edge,
+        )
+
+    def _defer(self, later: Deferred | None) -> None:
+        if later is not None:
+            self.deferred.append(later)
+
+    def _size_score(self, size: float, width: int) -> float:
+        distance = range_of(size, self.cfg.target_diameter_m, width, self.fov_deg)
+        if not self.vision.range_min_m <= distance <= self.vision.range_max_m:
+            return 0.0
+        return ramp(size, *SIZE)
+
+    def score(self, f: Features, width: int) -> float:
+        """0..1 (a frame asks it three or four times of one blob: remembered until the next frame's look)."""
+        known = self._scores.get(id(f))
+        if known is not None and known[0] is f and known[1] == width:
+            return known[2]
+        s = self._score(f, width)
+        if len(self._scores) >= SCORES_KEPT:
+            self._scores.clear()
+        self._scores[id(f)] = (f, width, s)
+        return s
+
+    def _score(self, f: Features, width: int) -> float:
+        shape = max(arc_score(f.arc, f.ellipse_arc), ramp(f.rim, *RIM)) * ramp(f.solidity, *SOLIDITY)
+        shape *= ramp(f.fill, *FILL) * ramp(f.elongation, *ELONGATION) * self._size_score(f.size, width)
+        colour = ramp(f.saturation, self.colour.sat_lo + SATURATION[0], self.colour.sat_lo + SATURATION[1])
+        colour *= 1.0 - ramp(f.hue_off, *HUE_OFF)
+        return shape * colour * ramp(f.ring, *RING)

@@ -1,0 +1,58 @@
+"""Rim support for the colour-ball detector (pilot/hsv.py): how much of a circle near a blob's is an edge in the
+image's brightness, facing the circle's centre.
+
+A ball's outline is an edge in brightness all the way round, whatever its colour mask shows: JPEG keeps the
+brightness at full resolution while it blocks the colour out in 8 or 16 px squares, and a ball lying on a surface
+of its own colour still stands out from it by its shading. A red shape's outline is an edge too, but not on a
+circle, and a red surface's texture is an edge here and there, not all the way round.
+
+The circle is looked for near the blob's enclosing circle (``SCALES`` x ``SHIFTS``: a frayed mask moves and sizes
+that circle a little), all circles sampled in one pass.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+from cv2.typing import MatLike
+
+from .hsv_shape import unit_circle
+
+EDGE = 40.0  # Sobel (3x3) response across the rim, about a 10-level step in brightness: sensor noise is below it
+RADIAL = 0.8  # the share of the gradient's square across the rim: within 27 degrees of the radius (0.5, 45
+# degrees, let a polygon's sides through wherever a circle runs along them: 3 red shapes of 300 on the tuning
+# photos, 1 at 0.8, 0 at 0.9 for 1-3 points of JPEG recall; dev seeds, not bench/vision's)
+SCALES = (0.85, 0.92, 1.0, 1.08, 1.16)  # circles tried: radii, in radii of the blob's enclosing circle...
+SHIFTS = (-0.15, 0.0, 0.15)  # ...and centres moved by this much in x and y (radii)
+
+_U = unit_circle(48)
+_FACTORS = np.array([k for k in SCALES for _ in SHIFTS for _ in SHIFTS])[:, None, None]
+_OFFSETS = np.array([(dx, dy) for _ in SCALES for dx in SHIFTS for dy in SHIFTS])[:, None, :]
+_UNIT = _FACTORS * _U[None, :, :] + _OFFSETS  # circles x points x (x, y), in radii from the blob's centre
+_REACH = max(SCALES) + max(SHIFTS) * 1.5  # the farthest a point lies from the centre, in radii (with margin)
+
+
+def rim_support(bgr: MatLike, cx: float, cy: float, r: float) -> float:
+    """The best share, over the circles tried near (cx, cy, r) in ``bgr``'s pixels, of a circle's 48 points
+    where the brightness's gradient is at least ``EDGE`` and points along the radius (either way: a ball's lit
+    side may be brighter than what lies behind it, its shaded side darker)."""
+    h, w = bgr.shape[:2]
+    reach = _REACH * r + 2.0
+    x0, y0 = max(0, int(cx - reach)), max(0, int(cy - reach))
+    x1, y1 = min(w, int(cx + reach) + 2), min(h, int(cy + reach) + 2)
+    if x1 - x0 < 3 or y1 - y0 < 3:
+        return 0.0
+    grey = cv2.cvtColor(np.ascontiguousarray(bgr[y0:y1, x0:x1]), cv2.COLOR_BGR2GRAY)
+    gx = cv2.Sobel(grey, cv2.CV_32F, 1, 0, ksize=3)
+    gy = cv2.Sobel(grey, cv2.CV_32F, 0, 1, ksize=3)
+    pos = _UNIT * r + (cx - x0 + 0.5, cy - y0 + 0.5)  # + 0.5: truncation rounds
+    ix, iy = pos[..., 0].astype(np.intp), pos[..., 1].astype(np.intp)
+    # the Sobel's outer row and column see the border, not the image: points there count as no edge
+    inside = (ix >= 1) & (ix < x1 - x0 - 1) & (iy >= 1) & (iy < y1 - y0 - 1)
+    ix, iy = np.where(inside, ix, 1), np.where(inside, iy, 1)
+    vx, vy = gx[iy, ix], gy[iy, ix]
+    across: npt.NDArray[np.float64] = vx * _U[:, 0] + vy * _U[:, 1]  # the circle's normal is its unit point
+    sq = across * across
+    good = inside & (sq >= EDGE * EDGE) & (sq >= RADIAL * (vx * vx + vy * vy))
+    return float(np.count_nonzero(good, axis=1).max()) / len(_U)
