@@ -101,8 +101,9 @@ class BlobMeasure:
         geometry *= ramp(elongation, *ELONGATION)
         if geometry <= 0.0 or geometry < least:
             return None
-        later = None if bgr is None or rim or decide or r < RIM_MIN_R else Deferred(
-            hsv, mask, c, area, x0, y0, scale, bgr, max(least, self.keep_from))
+        # what a rim look would need to measure it again, should its arcs or ring hold it down
+        later = (hsv, mask, c, area, x0, y0, scale, bgr) if bgr is not None and not (rim or decide or r < RIM_MIN_R) \
+            else None
         edge = rim_support(bgr, cx, cy, r) if rim and bgr is not None else 0.0
         pts = c.reshape(-1, 2)
         d2 = np.square(pts - (cx, cy)).sum(axis=1)
@@ -117,22 +118,25 @@ class BlobMeasure:
         # an ellipse no longer than ELLIPSE_ASPECT fills 1 / ELLIPSE_ASPECT of its enclosing circle or more: a blob
         # filling less has something sticking out (a red lamp on the tuning photos' motorbike passed as an ellipse)
         may_be_ellipse = arc < ARC[1] and fill >= 1.0 / ELLIPSE_ASPECT
-        if not may_be_ellipse and geometry * max(ramp(arc, *ARC), ramp(edge, *RIM)) < least:
-            self._defer(later)
+        round_part = max(ramp(arc, *ARC), ramp(edge, *RIM)) if edge else ramp(arc, *ARC)
+        if not may_be_ellipse and geometry * round_part < least:
+            self._defer(later, least)
             return None
         # the ring from 1.25 to 1.75 radii, sampled: outside the blob's circle, so the mask there is something else;
         # a rim all round walls the blob off from what is there (a ball on a surface of its colour)
-        ring = min(share_set(mask, cx, cy, RING_POINTS, max(r, 2.0)), 1.0 - edge)
+        ring = share_set(mask, cx, cy, RING_POINTS, max(r, 2.0))
+        if edge:
+            ring = min(ring, 1.0 - edge)
         geometry *= ramp(ring, *RING)
         if geometry <= 0.0 or geometry < least:
-            self._defer(later)
+            self._defer(later, least)
             return None
         ellipse_arc = ellipse_support(pts, real) if may_be_ellipse else 0.0
         hull = float(cv2.contourArea(cv2.convexHull(c)))
         solidity = area / hull if hull > 0 else 0.0
-        shape = max(arc_score(arc, ellipse_arc), ramp(edge, *RIM))
-        if shape < 1.0 or ring > RING[1]:
-            self._defer(later)  # held down by its arcs or ring, whether or not it passes
+        shape = max(arc_score(arc, ellipse_arc), ramp(edge, *RIM)) if edge else arc_score(arc, ellipse_arc)
+        if later is not None and (shape < 1.0 or ring > RING[1]):
+            self._defer(later, least)  # held down by its arcs or ring, whether or not it passes
         geometry *= shape * ramp(solidity, *SOLIDITY)
         if geometry <= 0.0 or geometry < least:
             return None
@@ -147,9 +151,10 @@ class BlobMeasure:
             edge,
         )
 
-    def _defer(self, later: Deferred | None) -> None:
+    def _defer(self, later: tuple[MatLike, MatLike, MatLike, float, int, int, int, MatLike] | None,
+               least: float) -> None:
         if later is not None:
-            self.deferred.append(later)
+            self.deferred.append(Deferred(*later, max(least, self.keep_from)))
 
     def _size_score(self, size: float, width: int) -> float:
         distance = range_of(size, self.cfg.target_diameter_m, width, self.fov_deg)
@@ -169,8 +174,9 @@ class BlobMeasure:
         return s
 
     def _score(self, f: Features, width: int) -> float:
-        shape = max(arc_score(f.arc, f.ellipse_arc), ramp(f.rim, *RIM)) * ramp(f.solidity, *SOLIDITY)
-        shape *= ramp(f.fill, *FILL) * ramp(f.elongation, *ELONGATION) * self._size_score(f.size, width)
+        shape = max(arc_score(f.arc, f.ellipse_arc), ramp(f.rim, *RIM)) if f.rim else arc_score(f.arc, f.ellipse_arc)
+        shape *= ramp(f.solidity, *SOLIDITY) * ramp(f.fill, *FILL)
+        shape *= ramp(f.elongation, *ELONGATION) * self._size_score(f.size, width)
         colour = ramp(f.saturation, self.colour.sat_lo + SATURATION[0], self.colour.sat_lo + SATURATION[1])
         colour *= 1.0 - ramp(f.hue_off, *HUE_OFF)
         return shape * colour * ramp(f.ring, *RING)
