@@ -124,7 +124,7 @@ class HsvBlobDetector(BlobMeasure):
     # -- candidates ---------------------------------------------------------------------------------
     def features(self, image: MatLike) -> list[Features]:
         """Every refined blob's features (unscored): a second look with a lower V bound when the first found
-        nothing scoring ``SECOND_LOOK_UNLESS``."""
+        nothing scoring ``SECOND_LOOK_UNLESS``, then a rim look when neither did."""
         w, h = frame_size(image)
         self.new_frame(w)
         scale = 2 if w >= SEARCH_MIN_WIDTH else 1
