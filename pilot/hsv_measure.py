@@ -101,9 +101,10 @@ class BlobMeasure:
         geometry *= ramp(elongation, *ELONGATION)
         if geometry <= 0.0 or geometry < least:
             return None
-        # what a rim look would need to measure it again, should its arcs or ring hold it down
-        later = (hsv, mask, c, area, x0, y0, scale, bgr) if bgr is not None and not (rim or decide or r < RIM_MIN_R) \
-            else None
+        # what a rim look would need to measure it again, should its arcs or ring hold it down (a piece an opening
+        # left is not deferred: its caller puts the widest disc's centre and size on it, a rim look would not)
+        later = (hsv, mask, c, area, x0, y0, scale, bgr) \
+            if bgr is not None and not (rim or decide or cut or r < RIM_MIN_R) else None
         edge = rim_support(bgr, cx, cy, r) if rim and bgr is not None else 0.0
         pts = c.reshape(-1, 2)
         d2 = np.square(pts - (cx, cy)).sum(axis=1)
