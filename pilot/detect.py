@@ -18,7 +18,7 @@ from cv2.typing import MatLike
 
 from .aruco import ArucoMarkerDetector, aruco_dictionary
 from .config import PilotConfig, VisionConfig
-from .detection import CandidateSource, Detection, Detector, FrameStatus, range_of
+from .detection import CandidateSource, Detection, Detector, FrameStatus, range_of, reported_size
 from .errors import ConfigError
 from .frames import FrameCheck
 from .hsv import HsvBlobDetector
@@ -50,17 +50,16 @@ class TrackedDetector:
 
     def detect(self, image: MatLike) -> Detection:
         status = self.frames.check(image)
-        shape: tuple[int, ...] = tuple(getattr(image, "shape", ()))
-        w, h = (int(shape[1]), int(shape[0])) if len(shape) >= 2 else (0, 0)
+        w, h = reported_size(image)
         if status is not FrameStatus.OK:
             self.tracker.reset()  # nothing seen through a bad frame carries over
             return Detection(False, width=w, height=h, status=status)
         candidates = self.source.candidates(image)
-        expected = self.tracker.expected()
-        if expected is not None and self.tracker.score >= self.look_again_from and not self.tracker.takes(
-                candidates, w):
-            # a target the pilot acts on, not in this frame's look: a closer look where it should be (a ball
-            # darkening as a bright window fills more of the frame drops under the frame's V bound)
+        # a target the pilot acts on, not in this frame's look: a closer look where it should be (a ball darkening
+        # as a bright window fills more of the frame drops under the frame's V bound); ``takes`` is False without
+        # a track, so the prediction is asked again only when the look is needed
+        if self.tracker.score >= self.look_again_from and not self.tracker.takes(candidates, w) and (
+                expected := self.tracker.expected()) is not None:
             candidates = candidates + self.source.candidates_near(image, *expected)
         out = self.tracker.update(candidates, w)
         if out is None:

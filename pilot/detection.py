@@ -112,15 +112,20 @@ def frame_size(image: MatLike) -> tuple[int, int]:
     return int(w), int(h)
 
 
+def reported_size(image: object) -> tuple[int, int]:
+    """Width and height of whatever was passed as a frame (0, 0 without two dimensions): what a Detection
+    reports, malformed frames included."""
+    shape: tuple[int, ...] = tuple(getattr(image, "shape", ()))
+    return (int(shape[1]), int(shape[0])) if len(shape) >= 2 else (0, 0)
+
+
 def best_detection(source: CandidateSource, image: MatLike, object_m: float, horizontal_fov_deg: float) -> Detection:
     """This frame alone, the source's best candidate (no tracking, none of the black, saturated or frozen frame
     checks: see ``pilot.detect.make_detector``), with its pinhole range for an object ``object_m`` across. A frame
     that is not an 8-bit 3-channel image of a usable size gets its status, not an OpenCV error."""
-    shape: tuple[int, ...] = tuple(getattr(image, "shape", ()))
+    w, h = reported_size(image)
     if (status := malformed(image)) is not None:
-        return Detection(False, width=int(shape[1]) if len(shape) >= 2 else 0,
-                         height=int(shape[0]) if shape else 0, status=status)
-    w, h = frame_size(image)
+        return Detection(False, width=w, height=h, status=status)
     cands = source.candidates(image)
     if not cands:
         return Detection(False, width=w, height=h)

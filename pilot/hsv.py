@@ -312,14 +312,13 @@ class HsvBlobDetector(BlobMeasure):
         return None if f is None else f._replace(cx=piece.cx + x0, cy=piece.cy + y0, size=2.0 * piece.radius + 1.0)
 
     def candidates(self, image: MatLike) -> list[Candidate]:
-        width = frame_size(image)[0]
-        found = []
-        for f in self.features(image):
-            s = self.score(f, width)
-            if s > 0.0 and s >= self.cfg.min_score:
-                found.append(Candidate(f.cx, f.cy, f.size, s))
-        found.sort(key=lambda c: c.score, reverse=True)
-        return found
+        return self._ranked(self.features(image), frame_size(image)[0])
+
+    def _ranked(self, found: list[Features], width: int) -> list[Candidate]:
+        """The blobs scoring above zero and at least ``min_score``, as candidates, best first."""
+        out = [Candidate(f.cx, f.cy, f.size, s) for f in found if (s := self.score(f, width)) > 0.0
+               and s >= self.cfg.min_score]
+        return sorted(out, key=lambda c: c.score, reverse=True)
 
     def candidates_near(self, image: MatLike, cx: float, cy: float, size: float) -> list[Candidate]:
         """Where a tracked ball should be and the frame's look found nothing: that window refined with the V
@@ -333,8 +332,7 @@ class HsvBlobDetector(BlobMeasure):
         if x1 - x0 < 2 or y1 - y0 < 2:
             return []
         found = self._refine(image, darker(self.colour.bounds_for(image), NEAR_GAIN), (x0, y0, x1 - x0, y1 - y0))
-        near = [Candidate(f.cx, f.cy, f.size, s) for f in found if (s := self.score(f, w)) >= self.cfg.min_score]
-        return sorted(near, key=lambda c: c.score, reverse=True)
+        return self._ranked(found, w)
 
     def detect(self, image: MatLike) -> Detection:
         """This frame alone, the best candidate (no tracking, no frame checks)."""
