@@ -49,6 +49,11 @@ edge all round them, which stands in for the arcs (a mask frayed by JPEG's colou
 isolation (a ball on a surface of its colour). Pieces cut by edges under ``hsv_edges.MIN_SIZE`` count with a rim
 of ``SMALL_RIM``.
 
+A frame where still nothing scores ``SECOND_LOOK_UNLESS`` gets a circle look (pilot/hsv_circles.py): in the first
+look's ``CIRCLE_BLOBS`` largest blobs' windows, circles of brightness edges with the target's colour inside. A ball
+on a textured surface of its colour, which even the edges cut into pieces (its shading is an edge inside it), is
+one blob with that surface; only its rim tells it apart. It costs about 1 ms a window, in frames with no ball.
+
 A tracked ball the frame's look misses gets a closer look where the track expects it (``candidates_near``, called
 by pilot/detect.py): that window refined with the V bound ``NEAR_GAIN`` times as high.
 
@@ -66,6 +71,7 @@ from cv2.typing import MatLike
 
 from .config import HsvConfig, VisionConfig
 from .detection import Candidate, Detection, best_detection, frame_size
+from .hsv_circles import circle_features
 from .hsv_colour import Bounds, darker
 from .hsv_edges import MIN_SIZE, WALL_GROWTH, cut_by_edges, walled_in
 from .hsv_measure import HALF_DECIDES, BlobMeasure
@@ -91,6 +97,8 @@ SECOND_LOOK_GAIN = 0.8  # ...with the V bound this much lower (a ball's shaded s
 SECOND_LOOK_MIN = 0.75  # ...keeps what scores this: a fallback needs stronger evidence (tuning photos' empty views)
 RIM_LOOKS = 6  # blobs held down by their arcs or ring measured again with their rim, at most
 SMALL_RIM = 0.85  # a piece cut by edges under MIN_SIZE counts with this rim support (not texture)
+CIRCLE_BLOBS = 2  # the largest search blobs the circle look searches
+BLOB_PAD = 4  # px: a search blob's window for the edges and the circle look is this much wider on each side
 NEAR_GAIN = 0.5  # a tracked ball's closer look: the V bound this much lower...
 NEAR_MARGIN = 0.1  # ...in a window this share of the frame's width wider than the ball on each side
 AIM_SPAN, AIM_SHARE = 0.35, 0.8  # the aim point's window (of the ball's diameter), and its share of target colour
@@ -111,6 +119,9 @@ class HsvBlobDetector(BlobMeasure):
         self, config: HsvConfig | None = None, vision: VisionConfig | None = None, fov_deg: float = 60.0
     ) -> None:
         super().__init__(config or HsvConfig(), vision or VisionConfig(), fov_deg)
+        self._blobs: list[tuple[float, MatLike, Box]] = []  # the first look's search blobs, for the circle look...
+        self._scale = 1  # ...and how much smaller than the frame the search is
+        self._windows: dict[Box, tuple[Bounds, MatLike, MatLike, MatLike]] = {}  # this frame's blob windows
 
     @property
     def single_range(self) -> bool:
@@ -127,6 +138,7 @@ class HsvBlobDetector(BlobMeasure):
         nothing scoring ``SECOND_LOOK_UNLESS``, then a rim look when neither did."""
         w, h = frame_size(image)
         self.new_frame(w)
+        self._windows.clear()
         scale = 2 if w >= SEARCH_MIN_WIDTH else 1
         small = cv2.resize(image, (w // scale, h // scale), interpolation=cv2.INTER_AREA) if scale > 1 else image
         bounds = self.colour.bounds_for(small)  # the exposure read where the resize has just been: in cache
@@ -141,7 +153,21 @@ class HsvBlobDetector(BlobMeasure):
             found += [f for f in more if _new(f, found) and self.score(f, w) >= SECOND_LOOK_MIN]
             if any(self.score(f, w) >= SECOND_LOOK_UNLESS for f in found):
                 return found
-        return self._rim_look(found)
+        found = self._rim_look(found)
+        if any(self.score(f, w) >= SECOND_LOOK_UNLESS for f in found):
+            return found
+        return found + self._circle_look(image, bounds, found)
+
+    def _circle_look(self, image: MatLike, bounds: Bounds, found: list[Features]) -> list[Features]:
+        """The circles in the first look's largest blobs' windows (pilot/hsv_circles.py)."""
+        out: list[Features] = []
+        k = self._scale
+        for _, _, (x, y, bw, bh) in sorted(self._blobs, key=lambda b: b[0], reverse=True)[:CIRCLE_BLOBS]:
+            if max(bw, bh) * k < SIZE[1]:
+                continue
+            x0, y0, roi, hsv, mask = self._blob_window(image, bounds, (x * k, y * k, bw * k, bh * k))
+            out += [f for f in circle_features(roi, hsv, mask, image, x0, y0, self.colour) if _new(f, found + out)]
+        return out
 
     def _rim_look(self, found: list[Features]) -> list[Features]:
         """The blobs held down by their arcs or ring measured again with their rim support; each replaces its
@@ -183,6 +209,8 @@ class HsvBlobDetector(BlobMeasure):
             if area < SPLIT_FILL * disc:
                 joined.append((area, c, box))
         boxes.sort(key=lambda b: b[0], reverse=True)
+        if splits:  # the first look's blobs: where the circle look would search
+            self._blobs, self._scale = blobs, scale
         found: list[Features] = []
         for area, c, (x, y, bw, bh) in boxes[:MAX_CANDIDATES]:
             across = max(bw, bh) * scale if scale > 1 else 0  # searched at full resolution: refined as it is
@@ -215,14 +243,11 @@ class HsvBlobDetector(BlobMeasure):
                     scale: int, found: list[Features]) -> list[Features]:
         """Balls on a surface of their colour: the largest search blobs' windows cut by the image's edges, the
         round pieces measured alone, their ring replaced by the share of their rim not walled in."""
-        w, h = frame_size(image)
         out: list[Features] = []
         for _, _, (x, y, bw, bh) in blobs[:EDGE_BLOBS]:
             if max(bw, bh) * scale < MIN_SIZE:
                 continue
-            x0, y0 = max(0, x * scale - 4), max(0, y * scale - 4)
-            roi, hsv, mask = self._window(image, bounds, x0, y0, min(w, (x + bw) * scale + 4),
-                                          min(h, (y + bh) * scale + 4))
+            x0, y0, roi, hsv, mask = self._blob_window(image, bounds, (x * scale, y * scale, bw * scale, bh * scale))
             cut = cut_by_edges(roi, mask, self.colour.kernel, self.cfg.min_area, SEARCH_FILL)
             for c, area in cut.pieces:
                 piece = np.zeros_like(np.asarray(mask))
@@ -273,6 +298,19 @@ class HsvBlobDetector(BlobMeasure):
             if f is not None and _new(f, found + out):
                 out.append(f)
         return out
+
+    def _blob_window(self, image: MatLike, bounds: Bounds, box: Box) -> tuple[int, int, MatLike, MatLike, MatLike]:
+        """A search blob's window (``BLOB_PAD`` wider), its corner, pixels, HSV and mask; remembered for the frame:
+        the edges and the circle look search the same blobs with the same bounds."""
+        w, h = frame_size(image)
+        x, y, bw, bh = box
+        x0, y0 = max(0, x - BLOB_PAD), max(0, y - BLOB_PAD)
+        key = (x0, y0, min(w, x + bw + BLOB_PAD), min(h, y + bh + BLOB_PAD))
+        known = self._windows.get(key)
+        if known is None or known[0] is not bounds:
+            known = (bounds, *self._window(image, bounds, *key))
+            self._windows[key] = known
+        return x0, y0, known[1], known[2], known[3]
 
     def _window(self, image: MatLike, bounds: Bounds, x0: int, y0: int, x1: int,
                 y1: int) -> tuple[MatLike, MatLike, MatLike]:

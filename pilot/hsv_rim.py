@@ -37,12 +37,32 @@ def rim_support(bgr: MatLike, cx: float, cy: float, r: float) -> float:
     """The best share, over the circles tried near (cx, cy, r) in ``bgr``'s pixels, of a circle's 48 points
     where the brightness's gradient is at least ``EDGE`` and points along the radius (either way: a ball's lit
     side may be brighter than what lies behind it, its shaded side darker)."""
+    counts = _counts(bgr, cx, cy, r)
+    return 0.0 if counts is None else float(counts.max()) / len(_U)
+
+
+def best_rim(bgr: MatLike, cx: float, cy: float, r: float) -> tuple[float, float, float, float]:
+    """``rim_support`` and the circle that has it (centre, radius)."""
+    counts = _counts(bgr, cx, cy, r)
+    if counts is None:
+        return 0.0, cx, cy, r
+    top = counts == counts.max()
+    # of the circles tied best, the widest (a ball's shading is an edge inside its rim, never outside it), their
+    # centres averaged (a clean rim ties several around the true one)
+    widest = float(_FACTORS[top, 0, 0].max())
+    top &= _FACTORS[:, 0, 0] == widest
+    dx, dy = _OFFSETS[top, 0].mean(axis=0)
+    return float(counts.max()) / len(_U), float(cx + dx * r), float(cy + dy * r), widest * r
+
+
+def _counts(bgr: MatLike, cx: float, cy: float, r: float) -> npt.NDArray[np.intp] | None:
+    """For each circle tried, how many of its points are on the rim; None where the window is too small."""
     h, w = bgr.shape[:2]
     reach = _REACH * r + 2.0
     x0, y0 = max(0, int(cx - reach)), max(0, int(cy - reach))
     x1, y1 = min(w, int(cx + reach) + 2), min(h, int(cy + reach) + 2)
     if x1 - x0 < 3 or y1 - y0 < 3:
-        return 0.0
+        return None
     grey = cv2.cvtColor(np.ascontiguousarray(bgr[y0:y1, x0:x1]), cv2.COLOR_BGR2GRAY)
     gx = cv2.Sobel(grey, cv2.CV_32F, 1, 0, ksize=3)
     gy = cv2.Sobel(grey, cv2.CV_32F, 0, 1, ksize=3)
@@ -55,4 +75,4 @@ def rim_support(bgr: MatLike, cx: float, cy: float, r: float) -> float:
     across: npt.NDArray[np.float64] = vx * _U[:, 0] + vy * _U[:, 1]  # the circle's normal is its unit point
     sq = across * across
     good = inside & (sq >= EDGE * EDGE) & (sq >= RADIAL * (vx * vx + vy * vy))
-    return float(np.count_nonzero(good, axis=1).max()) / len(_U)
+    return np.asarray(np.count_nonzero(good, axis=1), np.intp)

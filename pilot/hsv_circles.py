@@ -1,0 +1,148 @@
+"""The circle look of the colour-ball detector (pilot/hsv.py): balls the mask cannot separate at all, found by their
+rim in the image's brightness.
+
+A ball lying on a surface of its own colour (a red saucer, a red motorbike's tank) is one blob with it, and edges
+cut it into pieces too: its shading (the terminator, the highlight) is an edge inside it as strong as its rim. Its
+rim is still a circle of brightness edges whose gradients point along the radius. Here the window's edge pixels
+near the mask vote, along their gradient both ways, for the centre of a circle of each radius they might lie on
+(a Hough transform for circles); the best centres are checked for the target's colour inside, and for rim support
+(pilot/hsv_rim.py), which also refines the circle.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+from cv2.typing import MatLike
+
+from .hsv_colour import ColourMask
+from .hsv_rim import best_rim
+from .hsv_score import Features
+from .hsv_shape import unit_circle
+
+CANNY = (60, 150)  # hysteresis thresholds on the grey image (pilot/hsv_edges.py's, on each channel there)
+RADII = np.exp(np.arange(math.log(7.5), math.log(62.0), 0.15)).astype(np.float32)  # 15 % apart: 16-120 px balls
+CELL = 2  # px: the centre votes' grid
+EDGES_MAX = 800  # edge pixels voting at most (evenly thinned): the cost stays bounded in a textured window
+VOTES_MIN = 0.2  # the share of a circle's circumference that must have voted for its centre and radius
+CENTRES = 6  # the best centres checked per window
+INSIDE = 0.85  # the share of points inside the circle (to 0.8 radii) in the mask
+RIM_MIN = 0.8  # rim support below this is no ball (the score's RIM ramp then decides)
+
+_NEAR = np.ones((5, 5), np.uint8)  # edges this close to the mask vote (a rim lies just outside the blob's mask)
+_PEAK = np.ones((3, 3), np.uint8)
+_INSIDE_POINTS = np.concatenate([k * unit_circle(16) for k in (0.3, 0.55, 0.8)] + [np.zeros((1, 2))])
+
+
+class Circle(NamedTuple):
+    cx: float  # in the window
+    cy: float
+    r: float
+    inside: float  # share of the mask inside
+    rim: float  # rim support
+
+
+def centres(grey: MatLike, mask: MatLike, r_max: float) -> list[tuple[float, float, float]]:
+    """The ``CENTRES`` best circles (centre, radius; in the window) that the edges near the mask vote for."""
+    h, w = grey.shape[:2]
+    edges = cv2.bitwise_and(cv2.Canny(grey, *CANNY), cv2.dilate(mask, _NEAR))
+    ys, xs = np.nonzero(edges)
+    radii = RADII[: int(np.searchsorted(RADII, r_max, side="right"))]
+    if len(xs) < 12 or not len(radii):
+        return []
+    thinned = 1
+    if len(xs) > EDGES_MAX:
+        thinned = len(xs) // EDGES_MAX + 1
+        ys, xs = ys[::thinned], xs[::thinned]
+    gx, gy = _sobel_at(grey, ys, xs)
+    norm = np.sqrt(gx * gx + gy * gy) + 1e-6
+    ux, uy = (gx / norm)[:, None] * radii, (gy / norm)[:, None] * radii
+    fx, fy = xs.astype(np.float32)[:, None], ys.astype(np.float32)[:, None]
+    # a ball's lit side may be brighter than what is behind it, its shaded side darker: both ways
+    ix = (np.concatenate([fx + ux, fx - ux]) * (1.0 / CELL)).astype(np.int32)
+    iy = (np.concatenate([fy + uy, fy - uy]) * (1.0 / CELL)).astype(np.int32)
+    gw, gh = w // CELL + 1, h // CELL + 1
+    ok = (ix >= 0) & (ix < gw) & (iy >= 0) & (iy < gh)
+    if not ok.any():
+        return []
+    # each vote counts as the share of its circle's circumference it stands for; one radius at a time, keeping
+    # the best per cell (a whole frame's votes for every radius at once are megabytes, out of the caches)
+    cells = gh * gw
+    flat = iy * gw + ix
+    support = np.zeros(cells, np.float64)
+    best = np.zeros(cells, np.intp)
+    better = np.zeros(cells, np.bool_)
+    for k, radius in enumerate(radii):
+        votes = np.bincount(flat[:, k][ok[:, k]], minlength=cells) * (thinned / (2.0 * math.pi * float(radius)))
+        np.greater(votes, support, out=better)
+        np.copyto(support, votes, where=better)
+        best[better] = k
+    support = support.reshape(gh, gw).astype(np.float32)
+    support = cv2.boxFilter(support, -1, (3, 3), normalize=False)  # a centre between cells
+    peaks = (support >= VOTES_MIN) & (support >= cv2.dilate(support, _PEAK))
+    py, px = np.nonzero(peaks)
+    order = np.argsort(-support[py, px])[:CENTRES]
+    py, px = py[order], px[order]
+    return [((x + 0.5) * CELL, (y + 0.5) * CELL, float(radii[best[y * gw + x]])) for x, y in zip(px, py, strict=True)]
+
+
+def _sobel_at(grey: MatLike, ys: npt.NDArray[np.intp],
+              xs: npt.NDArray[np.intp]) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
+    """The 3x3 Sobel gradient at the given pixels only (the border replicated): no frame-sized arrays."""
+    g = np.asarray(grey)
+    h, w = g.shape[:2]
+    y0, y2 = np.maximum(ys - 1, 0), np.minimum(ys + 1, h - 1)
+    x0, x2 = np.maximum(xs - 1, 0), np.minimum(xs + 1, w - 1)
+
+    def at(yy: npt.NDArray[np.intp], xx: npt.NDArray[np.intp]) -> npt.NDArray[np.float32]:
+        return np.asarray(g[yy, xx], np.float32)
+
+    gx = at(y0, x2) + 2.0 * at(ys, x2) + at(y2, x2) - at(y0, x0) - 2.0 * at(ys, x0) - at(y2, x0)
+    gy = at(y2, x0) + 2.0 * at(y2, xs) + at(y2, x2) - at(y0, x0) - 2.0 * at(y0, xs) - at(y0, x2)
+    return gx, gy
+
+
+def inside_share(mask: MatLike, cx: float, cy: float, r: float) -> float:
+    """The share of 49 points inside the circle (to 0.8 radii) set in the mask; 0 if any falls outside it."""
+    h, w = mask.shape[:2]
+    pts = (_INSIDE_POINTS * r + (cx + 0.5, cy + 0.5)).astype(np.intp)
+    if pts.min() < 0 or pts[:, 0].max() >= w or pts[:, 1].max() >= h:
+        return 0.0
+    return float(np.count_nonzero(np.asarray(mask)[pts[:, 1], pts[:, 0]])) / len(pts)
+
+
+def circles(roi: MatLike, mask: MatLike, frame: MatLike, x0: int, y0: int) -> list[Circle]:
+    """The circles in the window at (x0, y0) of ``frame`` (``roi``, its smoothed pixels; ``mask``, its colour
+    mask) with the target's colour inside and a rim all round: the circle the rim support fits best (measured on
+    the frame: unsmoothed, and not cut by the window's edge)."""
+    grey = cv2.cvtColor(roi, cv2.COLOR_BGR2GRAY)
+    r_max = max(mask.shape[:2]) / 2.0
+    out: list[Circle] = []
+    for cx, cy, r in centres(grey, mask, r_max):
+        inside = inside_share(mask, cx, cy, r)
+        if inside < INSIDE:
+            continue
+        rim, bx, by, br = best_rim(frame, cx + x0, cy + y0, r)
+        bx, by = bx - x0, by - y0
+        if rim >= RIM_MIN and all(math.hypot(bx - c.cx, by - c.cy) > 1.0 for c in out):
+            out.append(Circle(bx, by, br, inside, rim))
+    return out
+
+
+def circle_features(roi: MatLike, hsv: MatLike, mask: MatLike, frame: MatLike, x0: int, y0: int,
+                    colour: ColourMask) -> list[Features]:
+    """The circles of a window at (x0, y0) of ``frame`` (``roi``, its smoothed pixels, their HSV and mask), as
+    the detector's features: the rim stands in for the arcs and for isolation (a ball on a surface of its colour),
+    the mask inside for the fill; the colour is the mask's inside 0.9 radii (the rim's pixels blend)."""
+    out = []
+    for c in circles(roi, mask, frame, x0, y0):
+        disc = np.zeros(mask.shape[:2], np.uint8)
+        cv2.circle(disc, (round(c.cx), round(c.cy)), max(1, int(0.9 * c.r)), 255, -1)
+        mean = cv2.mean(hsv, mask=cv2.bitwise_and(disc, mask))
+        out.append(Features(c.cx + x0, c.cy + y0, 2.0 * c.r, 0.0, 1.0, c.inside, 1.0, float(mean[1]),
+                            abs(float(mean[0]) - colour.hue_mid) / colour.hue_half, 1.0 - c.rim, 0.0, c.rim))
+    return out
