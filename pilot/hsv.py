@@ -23,7 +23,7 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
      target's colour: a ball stands apart; a hole in a red poster's print, a piece of a red box or of a brick
      wall does not.
    * size: the range the apparent diameter implies (known diameter, field of view) must be plausible, and
-     a blob under 16 px is scored down (too few pixels to show its shape).
+     a blob under 18 px is scored down (too few pixels to show its shape).
 
    The circle, not the blob's centroid, gives the position: a ball's dark side or a covered part moves
    a centroid, not the circle through its rim.
