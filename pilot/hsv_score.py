@@ -19,7 +19,7 @@ RIM = (0.65, 0.85)  # the rim's share that is a brightness edge (pilot/hsv_rim.p
 # false detections in 3,600 empty and distractor views)
 SIZE = (10.0, 18.0)  # diameter, pixels: a smaller blob has too few pixels to show its shape (from (8, 16): on the
 # tuning photos' dev seeds, 4 of 2,400 empty views with a detection instead of 10, 20 of 2,400 distractor views
-# instead of 29, and 4 balls fewer of 1,500)
+# instead of 27, and 4 balls fewer of 1,500)
 
 
 class Features(NamedTuple):
