@@ -144,19 +144,23 @@ class HsvBlobDetector(BlobMeasure):
         bounds = self.colour.bounds_for(small)  # the exposure read where the resize has just been: in cache
         small_hsv = cv2.cvtColor(small, self.colour.code)
         found = self._look(image, bounds, small, small_hsv, scale)
-        if any(self.score(f, w) >= SECOND_LOOK_UNLESS for f in found):
+        if self._enough(found, w):
             return found
         lower = darker(bounds, SECOND_LOOK_GAIN)
         if any(int(a[0][2]) != int(b[0][2]) for a, b in zip(lower, bounds, strict=True)):  # not at the floor
             self.keep_from = SECOND_LOOK_MIN
             more = self._look(image, lower, small, small_hsv, scale, splits=False)
             found += [f for f in more if _new(f, found) and self.score(f, w) >= SECOND_LOOK_MIN]
-            if any(self.score(f, w) >= SECOND_LOOK_UNLESS for f in found):
+            if self._enough(found, w):
                 return found
         found = self._rim_look(found)
-        if any(self.score(f, w) >= SECOND_LOOK_UNLESS for f in found):
+        if self._enough(found, w):
             return found
         return found + self._circle_look(image, bounds, found)
+
+    def _enough(self, found: list[Features], width: int) -> bool:
+        """Whether a look found something the pilot would act on (no further look then)."""
+        return any(self.score(f, width) >= SECOND_LOOK_UNLESS for f in found)
 
     def _circle_look(self, image: MatLike, bounds: Bounds, found: list[Features]) -> list[Features]:
         """The circles in the first look's largest blobs' windows (pilot/hsv_circles.py)."""

@@ -127,9 +127,8 @@ def circles(roi: MatLike, mask: MatLike, frame: MatLike, x0: int, y0: int) -> li
         if inside < INSIDE:
             continue
         rim, bx, by, br = best_rim(frame, cx + x0, cy + y0, r)
-        bx, by = bx - x0, by - y0
-        if rim >= RIM_MIN and all(math.hypot(bx - c.cx, by - c.cy) > 1.0 for c in out):
-            out.append(Circle(bx, by, br, inside, rim))
+        if rim >= RIM_MIN:  # two centres may fit the same rim: the detector keeps the first (hsv._new)
+            out.append(Circle(bx - x0, by - y0, br, inside, rim))
     return out
 
 

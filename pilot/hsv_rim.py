@@ -6,8 +6,9 @@ brightness at full resolution while it blocks the colour out in 8 or 16 px squar
 of its own colour still stands out from it by its shading. A red shape's outline is an edge too, but not on a
 circle, and a red surface's texture is an edge here and there, not all the way round.
 
-The circle is looked for near the blob's enclosing circle (``SCALES`` x ``SHIFTS``: a frayed mask moves and sizes
-that circle a little), all circles sampled in one pass.
+The circle is looked for near the one given, a blob's enclosing circle or one the circle look (pilot/hsv_circles.py)
+voted for (``SCALES`` x ``SHIFTS``: a frayed mask or a coarse vote moves and sizes it a little), all circles sampled
+in one pass.
 """
 
 from __future__ import annotations

@@ -36,7 +36,7 @@ class Features(NamedTuple):
     hue_off: float  # mean hue's distance from the range's middle, in half-widths
     ring: float  # the ring's share of the target's colour (a piece cut by edges: its rim's share not walled in)
     ellipse_arc: float  # 0 where the circle's arc was enough (it is measured only below ARC's one)
-    rim: float  # the rim support (pilot/hsv_rim.py), 0 unless the frame's rim look measured it
+    rim: float  # the rim support (pilot/hsv_rim.py), 0 unless measured (the rim and circle looks, small edge pieces)
 
 
 def ramp(value: float, zero: float, one: float) -> float:
