@@ -1,0 +1,81 @@
+"""The colour-ball detector reads a small round blob's saturation on its core (pilot/hsv_measure.py's
+core_saturation): blur blends a small ball's rim with what lies behind it, which would make a red ball read as pale
+as a pink one; a large ball, or a blob that is not round, is read whole."""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+import pytest
+
+import pilot.hsv_measure as hsv_measure
+from pilot.hsv import HsvBlobDetector
+from pilot.hsv_measure import blob_colour, core_saturation
+
+Image = npt.NDArray[np.uint8]
+CX, CY = 160, 120
+GREY = np.array((120.0, 125.0, 130.0))
+
+
+def blurred_ball(r: float, pale: float, sigma: float) -> Image:
+    """A matte ball of radius ``r`` at (CX, CY) on grey, lit from the upper left, its blue and green ``pale`` times
+    its red, blurred (Gaussian, ``sigma`` px)."""
+    yy, xx = np.mgrid[0:240, 0:320].astype(np.float64)
+    dx, dy = (xx - CX) / r, (yy - CY) / r
+    nz = np.sqrt(np.clip(1.0 - dx * dx - dy * dy, 0.0, 1.0))
+    shade = 220.0 * (0.4 + 0.6 * np.clip(-0.5 * dx - 0.5 * dy + math.sqrt(0.5) * nz, 0.0, 1.0))
+    alpha = np.clip(r + 0.5 - np.hypot(xx - CX, yy - CY), 0.0, 1.0)[..., None]
+    ball = np.stack([pale * shade, pale * shade, shade], axis=-1)
+    img = np.asarray(np.clip(GREY * (1.0 - alpha) + ball * alpha, 0, 255), np.uint8)
+    return np.asarray(cv2.GaussianBlur(img, (0, 0), sigma), np.uint8)
+
+
+def best(img: Image) -> tuple[float, float, float]:
+    """The best candidate's score and its offset from the ball's centre, and the saturation read on it."""
+    det = HsvBlobDetector()
+    found = det.candidates(img)
+    assert found, "no candidate at all"
+    c = found[0]
+    f = next(f for f in det.features(img) if abs(f.cx - c.cx) < 1e-6 and abs(f.cy - c.cy) < 1e-6)
+    return c.score, math.hypot(c.cx - CX, c.cy - CY), f.saturation
+
+
+@pytest.mark.parametrize("r,pale,sigma", [(8, 0.25, 2.0), (9, 0.3, 2.0)])
+def test_a_small_blurred_ball_is_read_on_its_core(r: float, pale: float, sigma: float,
+                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    img = blurred_ball(r, pale, sigma)
+    score, off, sat = best(img)
+    assert score >= 0.6 and off <= 2.0  # the default acquisition threshold
+    monkeypatch.setattr(hsv_measure, "CORE_BELOW", 0.0)  # read whole, as before
+    whole_score, _, whole_sat = best(img)
+    assert whole_score < 0.6
+    assert sat >= whole_sat + 5.0
+
+
+@pytest.mark.parametrize("r,pale", [(20, 0.3), (30, 0.4)])
+def test_a_large_ball_is_read_whole(r: float, pale: float, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A pink ball's core is as pale as its rim, and a large ball's rim is a small part of it: read whole, the pink
+    balls at the threshold stay below it."""
+    img = blurred_ball(r, pale, 2.0)
+    read = best(img)
+    monkeypatch.setattr(hsv_measure, "CORE_BELOW", 0.0)
+    assert best(img) == read
+
+
+def test_core_saturation_reads_the_eroded_mask_and_falls_back_on_the_whole() -> None:
+    mask = np.zeros((40, 40), np.uint8)
+    cv2.circle(mask, (20, 20), 9, 255, -1)
+    hsv = np.zeros((40, 40, 3), np.uint8)
+    hsv[..., 0], hsv[..., 1], hsv[..., 2] = 3, 220, 200
+    rim = cv2.subtract(mask, cv2.erode(mask, np.ones((3, 3), np.uint8)))
+    hsv[rim > 0, 0], hsv[rim > 0, 1] = 9, 120  # a paler rim of another hue
+    box = cv2.boundingRect(mask)
+    hue, whole = blob_colour(hsv, mask, box)
+    assert whole < 200.0 and hue > 3.0  # the rim counts in the whole blob's mean
+    assert core_saturation(hsv, mask, box, float(cv2.countNonZero(mask)), whole) == pytest.approx(220.0)
+    thin = np.zeros((40, 40), np.uint8)
+    cv2.line(thin, (5, 20), (35, 20), 255, 1)  # nothing left once eroded: the whole blob's
+    assert core_saturation(hsv, thin, cv2.boundingRect(thin), float(cv2.countNonZero(thin)), 123.0) == 123.0
