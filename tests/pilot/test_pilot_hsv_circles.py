@@ -1,6 +1,7 @@
 """The colour-ball detector's circle look (pilot/hsv_circles.py): a shaded ball lying on a textured surface of its
 own colour, which no mask separates, is found by the circle of brightness edges round it, and only in a frame
-where nothing else is; a red square or an open arc on the same surface is not made a ball."""
+where nothing else is; a red square, an open arc, a hollow or a texture of round things on the same surface is not
+made a ball."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ import pytest
 
 import pilot.hsv as hsv
 import pilot.hsv_circles as hsv_circles
-from pilot.hsv_circles import centres, circles, inside_share
+from pilot.hsv_circles import Circle, _objects, centres, circles, inside_share
 
 Image = npt.NDArray[np.uint8]
 CX, CY = 160, 120
@@ -26,17 +27,19 @@ def red_surface(seed: int, texture: float, value: float = 90.0) -> npt.NDArray[n
     return np.stack([0.2 * v, 0.2 * v, v], axis=-1)
 
 
-def on_surface(r: float, seed: int, texture: float) -> Image:
-    """A matte red ball of radius ``r`` at (CX, CY), lit from the upper left, on ``red_surface``."""
+def on_surface(r: float, seed: int, texture: float, centres: tuple[tuple[float, float], ...] = ((CX, CY),)) -> Image:
+    """Matte red balls of radius ``r`` at ``centres``, lit from the upper left, on ``red_surface``."""
     img = red_surface(seed, texture)
     yy, xx = np.mgrid[0:240, 0:320].astype(np.float64)
-    dx, dy = (xx - CX) / r, (yy - CY) / r
-    nz = np.sqrt(np.clip(1.0 - dx * dx - dy * dy, 0.0, 1.0))
-    lit = np.clip(-0.5 * dx - 0.5 * dy + math.sqrt(0.5) * nz, 0.0, 1.0)
-    shade = 220.0 * (0.3 + 0.7 * lit)
-    alpha = np.clip(r + 0.5 - np.hypot(xx - CX, yy - CY), 0.0, 1.0)[..., None]
-    ball = np.stack([0.15 * shade, 0.15 * shade, shade], axis=-1)
-    return np.asarray(np.clip(img * (1.0 - alpha) + ball * alpha, 0, 255), np.uint8)
+    for cx, cy in centres:
+        dx, dy = (xx - cx) / r, (yy - cy) / r
+        nz = np.sqrt(np.clip(1.0 - dx * dx - dy * dy, 0.0, 1.0))
+        lit = np.clip(-0.5 * dx - 0.5 * dy + math.sqrt(0.5) * nz, 0.0, 1.0)
+        shade = 220.0 * (0.3 + 0.7 * lit)
+        alpha = np.clip(r + 0.5 - np.hypot(xx - cx, yy - cy), 0.0, 1.0)[..., None]
+        ball = np.stack([0.15 * shade, 0.15 * shade, shade], axis=-1)
+        img = img * (1.0 - alpha) + ball * alpha
+    return np.asarray(np.clip(img, 0, 255), np.uint8)
 
 
 @pytest.mark.parametrize("r,seed,texture", [(9, 0, 20), (9, 1, 40), (12, 0, 40), (12, 1, 40)])
@@ -98,3 +101,36 @@ def test_a_plain_ball_never_pays_for_the_circle_look(monkeypatch: pytest.MonkeyP
     assert found and found[0].score >= 0.9 and not calls
     hsv.HsvBlobDetector().candidates(on_surface(12, 0, 40))
     assert calls  # the same counter sees the circle look run
+
+
+@pytest.mark.parametrize("centres", [((130, 110), (190, 130)), ((140, 120), (185, 120))])
+def test_several_round_things_on_one_surface_are_a_texture_not_a_ball(
+        centres: tuple[tuple[float, float], ...], monkeypatch: pytest.MonkeyPatch) -> None:
+    """Petals, a patterned cloth: one circle on a surface of the target's colour may be the ball, several are not."""
+    img = on_surface(12, 1, 40, centres)
+    found = hsv.HsvBlobDetector().candidates(img)
+    assert not found or found[0].score < 0.6
+    monkeypatch.setattr(hsv_circles, "_objects", lambda found: 1)  # each circle taken alone: both are found
+    near = [c for c in hsv.HsvBlobDetector().candidates(img) if c.score >= 0.6
+            and min(math.hypot(c.cx - x, c.cy - y) for x, y in centres) <= 3.0]
+    assert len(near) == 2
+
+
+def test_circles_fitting_one_rim_are_one_object() -> None:
+    one = [Circle(50.0, 50.0, 10.0, 1.0, 0.9), Circle(53.0, 51.0, 11.0, 1.0, 0.9)]
+    assert _objects(one) == 1 and _objects([*one, Circle(75.0, 50.0, 10.0, 1.0, 0.9)]) == 2
+    assert _objects([]) == 0
+
+
+def test_a_circle_with_a_hollow_inside_is_no_ball(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A dark hollow (a dahlia petal's cup) leaves a few of the inside points out of the mask: 6 of 49 here."""
+    grey = np.full((120, 160), 60, np.uint8)
+    cv2.circle(grey, (70, 55), 20, 200, -1, cv2.LINE_AA)
+    bgr = cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR)
+    mask = np.full((120, 160), 255, np.uint8)
+    assert len(circles(bgr, mask, bgr, 0, 0)) >= 1
+    cv2.rectangle(mask, (80, 48), (88, 62), 0, -1)  # on the inside points at 0.55 and 0.8 radii, angle 0 +- 22.5
+    assert 0.85 < inside_share(mask, 70, 55, 20) < 0.95
+    assert circles(bgr, mask, bgr, 0, 0) == []
+    monkeypatch.setattr(hsv_circles, "INSIDE", 0.85)
+    assert len(circles(bgr, mask, bgr, 0, 0)) >= 1
