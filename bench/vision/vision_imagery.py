@@ -3,7 +3,10 @@ distractors that are not the target, and the conditions a drone's camera meets. 
 
 Photographs: the colour (and two grey) photos that ship inside scikit-image's wheel (``skimage.data``;
 the ones that need ``pooch`` to download are not used). The split is fixed here, before any threshold
-was chosen: the detectors are tuned on ``TUNING`` and only reported on ``HELD_OUT``.
+was chosen: the detectors are tuned on ``TUNING`` and only reported on ``HELD_OUT``. ``VALIDATION``, the two
+photos in scikit-learn's wheel, came later: scenes red and orange through and through, where the detector
+fired on 4.8 % of empty views; the circle look's checks were then chosen on them and the tuning photos
+(pilot/hsv_circles.py), so they are reported apart, and are not held out.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ W, H = 320, 240
 # name -> loader name in skimage.data (a tuple picks one image of a stereo pair)
 TUNING = ("chelsea", "coffee", "rocket", "immunohistochemistry", "colorwheel", "motorcycle_left", "brick")
 HELD_OUT = ("astronaut", "retina", "logo", "hubble_deep_field", "motorcycle_right", "gravel")
+VALIDATION = ("china", "flower")  # sklearn.datasets' sample photos: a temple's red columns, an orange dahlia
 CONDITIONS = ("clean", "perspective", "gaussian_blur", "motion_blur", "jpeg", "dim", "bright", "warm", "noise",
               "occlusion")
 DISTRACTOR_KINDS = ("orange", "pink", "red_brown", "red_shape", "red_poster")
@@ -35,7 +39,11 @@ def photo(name: str) -> Image:
     """A photograph as BGR uint8 (motorcycle_left/right: the two views of skimage's stereo pair)."""
     import skimage.data
 
-    if name.startswith("motorcycle_"):
+    if name in VALIDATION:
+        from sklearn.datasets import load_sample_image
+
+        rgb = load_sample_image(f"{name}.jpg")
+    elif name.startswith("motorcycle_"):
         left, right, _ = skimage.data.stereo_motorcycle()  # type: ignore[no-untyped-call]
         rgb = left if name.endswith("left") else right
     else:

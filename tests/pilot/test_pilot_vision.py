@@ -141,3 +141,13 @@ def test_real_photos_hsv_floors(small_eval: tuple[list[ve.Record], list[ve.Recor
     assert sum(rows.values()) / len(rows) >= 0.75  # 0.84 reached (0.78 before the split and the ellipse)
     assert ve.false_rows(hsv, threshold, "empty")[-1].rate <= 0.02  # at most 1 of 60 (none now)
     assert ve.false_rows(hsv, threshold, "distractor")[-1].rate <= 0.05  # at most 2 of 40 (none now)
+
+
+def test_real_photos_hsv_stays_quiet_in_red_and_orange_scenes() -> None:
+    """scikit-learn's two photos (a temple's red columns, a dahlia close up) are the target's colour throughout:
+    empty views there fire the detector far more often than elsewhere. A regression floor: 6 of these 300 fire
+    now, 12 did before the circle look's checks for hollows and textures (pilot/hsv_circles.py)."""
+    views = ve.samples(vi.VALIDATION, 15, 0, 300, 0, "ball", (16.0, 120.0), ())
+    empty = ve.false_rows(ve.run(HsvBlobDetector().detect, views), ControllerConfig().acquire_confidence, "empty")
+    assert empty[-1].group == "all" and empty[-1].n == 300
+    assert empty[-1].rate <= 9 / 300
