@@ -17,8 +17,9 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
      robustly to it (a ball seen through a perspective warp, or with a stub of background attached; its ramp
      is stricter, as an ellipse fits a square's sides better than the enclosing circle does), solidity, fill of
      that circle, and the aspect of its minimum-area rectangle (a rotated bar has a square bounding box).
-   * colour purity: mean saturation, and how far the mean hue sits from the middle of the range (orange
-     and red-brown sit near its edge, the target's red in the middle).
+   * colour purity: mean saturation (a small round blob's on its core: blur blends its rim), and how far the
+     mean hue sits from the middle of the range (orange and red-brown sit near its edge, the target's red in the
+     middle).
    * isolation: the share of the ring around the circle (1.25 to 1.75 radii, sampled) that is of the
      target's colour: a ball stands apart; a hole in a red poster's print, a piece of a red box or of a brick
      wall does not.
@@ -50,9 +51,10 @@ isolation (a ball on a surface of its colour). Pieces cut by edges under ``hsv_e
 of ``SMALL_RIM``.
 
 A frame where still nothing scores ``SECOND_LOOK_UNLESS`` gets a circle look (pilot/hsv_circles.py): in the first
-look's ``CIRCLE_BLOBS`` largest blobs' windows, circles of brightness edges with the target's colour inside. A ball
-on a textured surface of its colour, which even the edges cut into pieces (its shading is an edge inside it), is
-one blob with that surface; only its rim tells it apart. It costs about 1 ms a window, in frames with no ball.
+look's ``CIRCLE_BLOBS`` largest blobs' windows, circles of brightness edges with the target's colour inside (one
+circle to a window: several are a texture of round things, a flower's petals). A ball on a textured surface of its
+colour, which even the edges cut into pieces (its shading is an edge inside it), is one blob with that surface;
+only its rim tells it apart. It costs about 1 ms a window, in frames with no ball.
 
 A tracked ball the frame's look misses gets a closer look where the track expects it (``candidates_near``, called
 by pilot/detect.py): that window refined with the V bound ``NEAR_GAIN`` times as high.
