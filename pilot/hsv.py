@@ -19,7 +19,7 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
      that circle, and the aspect of its minimum-area rectangle (a rotated bar has a square bounding box).
    * colour purity: mean saturation (a small round blob's on its core: blur blends its rim), and how far the
      mean hue sits from the middle of the range (orange and red-brown sit near its edge, the target's red in the
-     middle).
+     middle; read without clipped pixels where it holds the score down: an over-exposed red reads orange).
    * isolation: the share of the ring around the circle (1.25 to 1.75 radii, sampled) that is of the
      target's colour: a ball stands apart; a hole in a red poster's print, a piece of a red box or of a brick
      wall does not.

@@ -1,6 +1,7 @@
-"""The colour-ball detector reads a small round blob's saturation on its core (pilot/hsv_measure.py's
-core_saturation): blur blends a small ball's rim with what lies behind it, which would make a red ball read as pale
-as a pink one; a large ball, or a blob that is not round, is read whole."""
+"""How the colour-ball detector reads a blob's colour where the whole blob's mean would hold its score down
+(pilot/hsv_measure.py): a small round blob's saturation on its core (blur blends a small ball's rim with what lies
+behind it, which would make a red ball read as pale as a pink one; a large ball is read whole), and the hue
+without the clipped pixels (an over-exposed red ball's lit side reads orange)."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ import pytest
 
 import pilot.hsv_measure as hsv_measure
 from pilot.hsv import HsvBlobDetector
-from pilot.hsv_measure import blob_colour, core_saturation
+from pilot.hsv_measure import blob_colour, core_saturation, unclipped_hue
 
 Image = npt.NDArray[np.uint8]
 CX, CY = 160, 120
@@ -79,3 +80,44 @@ def test_core_saturation_reads_the_eroded_mask_and_falls_back_on_the_whole() -> 
     thin = np.zeros((40, 40), np.uint8)
     cv2.line(thin, (5, 20), (35, 20), 255, 1)  # nothing left once eroded: the whole blob's
     assert core_saturation(hsv, thin, cv2.boundingRect(thin), float(cv2.countNonZero(thin)), 123.0) == 123.0
+
+
+def lit_ball(r: float, hue: int, gain: float) -> Image:
+    """A matte ball of hue ``hue`` (OpenCV units) at (CX, CY) on a dull green-grey, lit from the upper left, the
+    frame's exposure ``gain`` times too high (clipped at 255, as a camera's is)."""
+    base = cv2.cvtColor(np.array([[[hue, 210, 210]]], np.uint8), cv2.COLOR_HSV2BGR).reshape(3).astype(np.float64)
+    yy, xx = np.mgrid[0:240, 0:320].astype(np.float64)
+    dx, dy = (xx - CX) / r, (yy - CY) / r
+    nz = np.sqrt(np.clip(1.0 - dx * dx - dy * dy, 0.0, 1.0))
+    shade = (0.35 + 0.65 * np.clip(-0.5 * dx - 0.5 * dy + math.sqrt(0.5) * nz, 0.0, 1.0))[..., None] * base
+    alpha = np.clip(r + 0.5 - np.hypot(xx - CX, yy - CY), 0.0, 1.0)[..., None]
+    img = np.array((90.0, 110.0, 100.0)) * (1.0 - alpha) + shade * alpha
+    return np.asarray(np.clip(img * gain, 0, 255), np.uint8)
+
+
+@pytest.mark.parametrize("hue", [4, 176])  # red, a little towards orange and towards magenta
+def test_an_over_exposed_ball_keeps_its_hue(hue: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    bright = lit_ball(20, hue, 1.8)
+    score, off, _ = best(bright)
+    assert score >= 0.6 and off <= 2.0
+    monkeypatch.setattr(hsv_measure, "CLIPPED", 256)  # every pixel's hue read, clipped or not
+    assert best(bright)[0] < 0.6
+    well_exposed = lit_ball(20, hue, 1.0)
+    every_pixel = best(well_exposed)
+    monkeypatch.undo()
+    assert best(well_exposed) == every_pixel and every_pixel[0] >= 0.6  # nothing clips: the same reading
+
+
+def test_unclipped_hue_leaves_out_the_clipped_pixels_and_falls_back_on_the_whole() -> None:
+    mask = np.zeros((40, 40), np.uint8)
+    cv2.circle(mask, (20, 20), 9, 255, -1)
+    hsv = np.zeros((40, 40, 3), np.uint8)
+    hsv[..., 0], hsv[..., 1], hsv[..., 2] = 2, 220, 180
+    hsv[:20, :, 0], hsv[:20, :, 2] = 12, 255  # the upper half clipped, its hue drifted
+    box = cv2.boundingRect(mask)
+    area = float(cv2.countNonZero(mask))
+    hue, _ = blob_colour(hsv, mask, box)
+    assert hue > 5.0
+    assert unclipped_hue(hsv, mask, box, area, hue) == pytest.approx(2.0)
+    hsv[..., 2] = 255  # all clipped: nothing to read instead
+    assert unclipped_hue(hsv, mask, box, area, hue) == hue
