@@ -161,5 +161,5 @@ def circle_features(roi: MatLike, hsv: MatLike, mask: MatLike, frame: MatLike, x
         cv2.circle(disc, (round(c.cx), round(c.cy)), max(1, int(0.9 * c.r)), 255, -1)
         mean = cv2.mean(hsv, mask=cv2.bitwise_and(disc, mask))
         out.append(Features(c.cx + x0, c.cy + y0, 2.0 * c.r, 0.0, 1.0, c.inside, 1.0, float(mean[1]),
-                            abs(float(mean[0]) - colour.hue_mid) / colour.hue_half, 1.0 - c.rim, 0.0, c.rim))
+                            colour.hue_off(float(mean[0])), 1.0 - c.rim, 0.0, c.rim))
     return out

@@ -65,6 +65,10 @@ class ColourMask:
         k = max(1, cfg.open_kernel)
         self.kernel = cv2.getStructuringElement(cv2.MORPH_RECT, (k, k)) if k > 1 else None
 
+    def hue_off(self, hue: float) -> float:
+        """How far a mean hue sits from the range's middle, in half-widths (the score's colour purity)."""
+        return abs(hue - self.hue_mid) / self.hue_half
+
     @property
     def single_range(self) -> bool:
         """True when the mask costs one cvtColor and one inRange (contiguous hues, shared S/V bounds)."""

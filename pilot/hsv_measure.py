@@ -151,13 +151,13 @@ class BlobMeasure:
         hue, sat = blob_colour(hsv, mask, box)
         if sat < self.colour.sat_lo + SATURATION[1] and size < CORE_BELOW and max(arc, edge) >= CORE_ROUND:
             sat = core_saturation(hsv, mask, box, area, sat)  # only where the saturation holds the score down
-        if abs(hue - self.colour.hue_mid) / self.colour.hue_half > HUE_OFF[0]:
-            hue = unclipped_hue(hsv, mask, box, area, hue)  # only where the hue holds the score down
+        hue_off = self.colour.hue_off(hue)
+        if hue_off > HUE_OFF[0]:  # only where the hue holds the score down
+            hue_off = self.colour.hue_off(unclipped_hue(hsv, mask, box, area, hue))
         half = (scale - 1) / 2.0  # a pixel's centre at half resolution lies between two at full resolution
         return Features(
-            (cx + x0) * scale + half, (cy + y0) * scale + half, size, arc, solidity, fill, elongation,
-            sat, abs(hue - self.colour.hue_mid) / self.colour.hue_half, ring, ellipse_arc,
-            edge,
+            (cx + x0) * scale + half, (cy + y0) * scale + half, size, arc, solidity, fill, elongation, sat, hue_off,
+            ring, ellipse_arc, edge,
         )
 
     def _defer(self, later: tuple[MatLike, MatLike, MatLike, float, int, int, int, MatLike] | None,
@@ -194,10 +194,24 @@ class BlobMeasure:
 _CORE = np.ones((3, 3), np.uint8)
 
 
+def _slices(box: Sequence[int], pad: int, shape: tuple[int, ...]) -> tuple[slice, slice]:
+    """The rows and columns of a blob's bounding box, ``pad`` px wider on each side within the image."""
+    bx, by, bw, bh = box
+    h, w = shape[:2]
+    return slice(max(0, by - pad), min(h, by + bh + pad)), slice(max(0, bx - pad), min(w, bx + bw + pad))
+
+
+def _mean_where(window: MatLike, keep: MatLike, channel: int, area: float, least: float, whole: float) -> float:
+    """The mean of one HSV channel over the pixels ``keep`` sets (``whole`` where they are fewer than ``least`` of
+    the blob's area)."""
+    if cv2.countNonZero(keep) < least * area:
+        return whole
+    return float(cv2.mean(window, mask=keep)[channel])
+
+
 def blob_colour(hsv: MatLike, mask: MatLike, box: Sequence[int]) -> tuple[float, float]:
     """The mean hue and saturation over the blob's box (the mask's pixels there are the blob's, or nearly)."""
-    bx, by, bw, bh = box
-    tight = (slice(by, by + bh), slice(bx, bx + bw))
+    tight = _slices(box, 0, mask.shape)
     mean = cv2.mean(hsv[tight], mask=mask[tight])
     return float(mean[0]), float(mean[1])
 
@@ -212,14 +226,9 @@ def core_saturation(hsv: MatLike, mask: MatLike, box: Sequence[int], area: float
     core (and the hue too), 3 more of 4,800 empty and distractor views passed; on large round blobs too, 5 pink
     balls at the threshold; the hue on the core, a shaded ball's sat further off the range's middle than the whole
     ball's."""
-    bx, by, bw, bh = box
-    h, w = mask.shape[:2]
-    wide = (slice(max(0, by - 1), min(h, by + bh + 1)), slice(max(0, bx - 1), min(w, bx + bw + 1)))
+    wide = _slices(box, 1, mask.shape)
     inner = cv2.erode(np.asarray(mask)[wide], _CORE, borderType=cv2.BORDER_CONSTANT, borderValue=0)
-    if cv2.countNonZero(inner) < CORE_MIN * area:
-        return whole
-    return float(cv2.mean(hsv[wide], mask=inner)[1])
-
+    return _mean_where(hsv[wide], inner, 1, area, CORE_MIN, whole)
 
 
 def unclipped_hue(hsv: MatLike, mask: MatLike, box: Sequence[int], area: float, whole: float) -> float:
@@ -229,11 +238,7 @@ def unclipped_hue(hsv: MatLike, mask: MatLike, box: Sequence[int], area: float, 
     0.6 on the tuning photos (3 in the bright condition) and 2 of 1,700 on the validation photos (both bright),
     none fewer; 1 empty view more of 9,600 on the validation photos, the same in 14,400 empty and distractor views
     on the tuning photos."""
-    bx, by, bw, bh = box
-    tight = (slice(by, by + bh), slice(bx, bx + bw))
+    tight = _slices(box, 0, mask.shape)
     window = np.asarray(hsv)[tight]
     lit = cv2.inRange(window, (0, 0, 0), (255, 255, CLIPPED - 1))
-    keep = cv2.bitwise_and(np.asarray(mask)[tight], lit)
-    if cv2.countNonZero(keep) < CLIP_MIN * area:
-        return whole
-    return float(cv2.mean(window, mask=keep)[0])
+    return _mean_where(window, cv2.bitwise_and(np.asarray(mask)[tight], lit), 0, area, CLIP_MIN, whole)
