@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import math
+
 import cv2
 import numpy as np
 import numpy.typing as npt
 
 Image = npt.NDArray[np.uint8]
+FloatImage = npt.NDArray[np.float64]
 
 RED = (30, 30, 210)  # BGR
 DISTRACTORS = {
@@ -56,3 +59,16 @@ def paste_marker(bg: Image, marker: Image, cx: int, cy: int) -> Image:
     img[y0 - border : y0 + side + border, x0 - border : x0 + side + border] = 255
     img[y0 : y0 + side, x0 : x0 + side] = marker
     return img
+
+
+def matte_ball(bg: FloatImage, cx: float, cy: float, r: float, colour: tuple[float, float, float],
+               ambient: float) -> FloatImage:
+    """``bg`` (BGR, float) with a matte ball of radius ``r`` at (cx, cy), lit from the upper left: ``colour`` (BGR)
+    where the light falls square on it, ``ambient`` of it on its shaded side; its rim anti-aliased."""
+    yy, xx = np.mgrid[0 : bg.shape[0], 0 : bg.shape[1]].astype(np.float64)
+    dx, dy = (xx - cx) / r, (yy - cy) / r
+    nz = np.sqrt(np.clip(1.0 - dx * dx - dy * dy, 0.0, 1.0))
+    lit = np.clip(-0.5 * dx - 0.5 * dy + math.sqrt(0.5) * nz, 0.0, 1.0)
+    ball = (ambient + (1.0 - ambient) * lit)[..., None] * np.array(colour, np.float64)
+    alpha = np.clip(r + 0.5 - np.hypot(xx - cx, yy - cy), 0.0, 1.0)[..., None]
+    return np.asarray(bg * (1.0 - alpha) + ball * alpha, np.float64)

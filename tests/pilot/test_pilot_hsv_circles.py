@@ -11,6 +11,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 import pytest
+from pilot_synth import matte_ball
 
 import pilot.hsv as hsv
 import pilot.hsv_circles as hsv_circles
@@ -30,15 +31,8 @@ def red_surface(seed: int, texture: float, value: float = 90.0) -> npt.NDArray[n
 def on_surface(r: float, seed: int, texture: float, centres: tuple[tuple[float, float], ...] = ((CX, CY),)) -> Image:
     """Matte red balls of radius ``r`` at ``centres``, lit from the upper left, on ``red_surface``."""
     img = red_surface(seed, texture)
-    yy, xx = np.mgrid[0:240, 0:320].astype(np.float64)
     for cx, cy in centres:
-        dx, dy = (xx - cx) / r, (yy - cy) / r
-        nz = np.sqrt(np.clip(1.0 - dx * dx - dy * dy, 0.0, 1.0))
-        lit = np.clip(-0.5 * dx - 0.5 * dy + math.sqrt(0.5) * nz, 0.0, 1.0)
-        shade = 220.0 * (0.3 + 0.7 * lit)
-        alpha = np.clip(r + 0.5 - np.hypot(xx - cx, yy - cy), 0.0, 1.0)[..., None]
-        ball = np.stack([0.15 * shade, 0.15 * shade, shade], axis=-1)
-        img = img * (1.0 - alpha) + ball * alpha
+        img = matte_ball(img, cx, cy, r, (0.15 * 220.0, 0.15 * 220.0, 220.0), 0.3)
     return np.asarray(np.clip(img, 0, 255), np.uint8)
 
 

@@ -11,6 +11,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 import pytest
+from pilot_synth import matte_ball
 
 import pilot.hsv_measure as hsv_measure
 from pilot.hsv import HsvBlobDetector
@@ -24,13 +25,8 @@ GREY = np.array((120.0, 125.0, 130.0))
 def blurred_ball(r: float, pale: float, sigma: float) -> Image:
     """A matte ball of radius ``r`` at (CX, CY) on grey, lit from the upper left, its blue and green ``pale`` times
     its red, blurred (Gaussian, ``sigma`` px)."""
-    yy, xx = np.mgrid[0:240, 0:320].astype(np.float64)
-    dx, dy = (xx - CX) / r, (yy - CY) / r
-    nz = np.sqrt(np.clip(1.0 - dx * dx - dy * dy, 0.0, 1.0))
-    shade = 220.0 * (0.4 + 0.6 * np.clip(-0.5 * dx - 0.5 * dy + math.sqrt(0.5) * nz, 0.0, 1.0))
-    alpha = np.clip(r + 0.5 - np.hypot(xx - CX, yy - CY), 0.0, 1.0)[..., None]
-    ball = np.stack([pale * shade, pale * shade, shade], axis=-1)
-    img = np.asarray(np.clip(GREY * (1.0 - alpha) + ball * alpha, 0, 255), np.uint8)
+    grey = np.broadcast_to(GREY, (240, 320, 3))
+    img = np.asarray(np.clip(matte_ball(grey, CX, CY, r, (pale * 220.0, pale * 220.0, 220.0), 0.4), 0, 255), np.uint8)
     return np.asarray(cv2.GaussianBlur(img, (0, 0), sigma), np.uint8)
 
 
@@ -86,12 +82,8 @@ def lit_ball(r: float, hue: int, gain: float) -> Image:
     """A matte ball of hue ``hue`` (OpenCV units) at (CX, CY) on a dull green-grey, lit from the upper left, the
     frame's exposure ``gain`` times too high (clipped at 255, as a camera's is)."""
     base = cv2.cvtColor(np.array([[[hue, 210, 210]]], np.uint8), cv2.COLOR_HSV2BGR).reshape(3).astype(np.float64)
-    yy, xx = np.mgrid[0:240, 0:320].astype(np.float64)
-    dx, dy = (xx - CX) / r, (yy - CY) / r
-    nz = np.sqrt(np.clip(1.0 - dx * dx - dy * dy, 0.0, 1.0))
-    shade = (0.35 + 0.65 * np.clip(-0.5 * dx - 0.5 * dy + math.sqrt(0.5) * nz, 0.0, 1.0))[..., None] * base
-    alpha = np.clip(r + 0.5 - np.hypot(xx - CX, yy - CY), 0.0, 1.0)[..., None]
-    img = np.array((90.0, 110.0, 100.0)) * (1.0 - alpha) + shade * alpha
+    bg = np.broadcast_to(np.array((90.0, 110.0, 100.0)), (240, 320, 3))
+    img = matte_ball(bg, CX, CY, r, (float(base[0]), float(base[1]), float(base[2])), 0.35)
     return np.asarray(np.clip(img * gain, 0, 255), np.uint8)
 
 
