@@ -16,7 +16,9 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
      disk with 30 % hidden behind an edge ~0.7, a square ~0.3) or, where that is low, on an ellipse fitted
      robustly to it (a ball seen through a perspective warp, or with a stub of background attached; its ramp
      is stricter, as an ellipse fits a square's sides better than the enclosing circle does), solidity, fill of
-     that circle, and the aspect of its minimum-area rectangle (a rotated bar has a square bounding box).
+     that circle, and the aspect and fill of its minimum-area rectangle (a rotated bar has a square bounding box; a
+     disc fills pi / 4 of its rectangle, a small square blurred round all of it; a blob whose outline keeps to its
+     circle may be longer: a ball partly hidden, or with its shaded side out of the mask).
    * colour purity: mean saturation (a small round blob's on its core: blur blends its rim), and how far the
      mean hue sits from the middle of the range (orange and red-brown sit near its edge, the target's red in the
      middle; read without clipped pixels where it holds the score down: an over-exposed red reads orange).

@@ -160,6 +160,6 @@ def circle_features(roi: MatLike, hsv: MatLike, mask: MatLike, frame: MatLike, x
         disc = np.zeros(mask.shape[:2], np.uint8)
         cv2.circle(disc, (round(c.cx), round(c.cy)), max(1, int(0.9 * c.r)), 255, -1)
         mean = cv2.mean(hsv, mask=cv2.bitwise_and(disc, mask))
-        out.append(Features(c.cx + x0, c.cy + y0, 2.0 * c.r, 0.0, 1.0, c.inside, 1.0, float(mean[1]),
+        out.append(Features(c.cx + x0, c.cy + y0, 2.0 * c.r, 0.0, 1.0, c.inside, 1.0, math.pi / 4.0, float(mean[1]),
                             colour.hue_off(float(mean[0])), 1.0 - c.rim, 0.0, c.rim))
     return out

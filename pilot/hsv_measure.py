@@ -24,7 +24,7 @@ from .hsv_rim import rim_support
 from .hsv_score import (
     ARC,
     ARC_TOL,
-    ELONGATION,
+    ELONGATION_ROUND,
     FILL,
     HUE_OFF,
     RIM,
@@ -34,6 +34,7 @@ from .hsv_score import (
     SOLIDITY,
     Features,
     arc_score,
+    outline_score,
     ramp,
 )
 from .hsv_shape import ELLIPSE_ASPECT, RING_POINTS, ellipse_support, outer_rim, share_set
@@ -104,8 +105,9 @@ class BlobMeasure:
             return None
         (_, _), (rw, rh), _ = cv2.minAreaRect(c)
         elongation = max(rw, rh) / max(1e-6, min(rw, rh))
-        geometry *= ramp(elongation, *ELONGATION)
-        if geometry <= 0.0 or geometry < least:
+        box_fill = area / max(1e-6, rw * rh)
+        most = geometry * ramp(elongation, *ELONGATION_ROUND)  # the rectangle's score depends on the arcs, to come
+        if most <= 0.0 or most < least:
             return None
         # what a rim look would need to measure it again, should its arcs or ring hold it down (a piece an opening
         # left is not deferred: its caller puts the widest disc's centre and size on it, a rim look would not)
@@ -121,6 +123,9 @@ class BlobMeasure:
             on_arc &= real
         arc = float(np.count_nonzero(on_arc)) / len(pts)
         if decide and arc < HALF_ARC:
+            return None
+        geometry *= outline_score(elongation, box_fill, arc, size)
+        if geometry <= 0.0 or geometry < least:  # neither its rim nor its ring would lift it (no rim look)
             return None
         # an ellipse no longer than ELLIPSE_ASPECT fills 1 / ELLIPSE_ASPECT of its enclosing circle or more: a blob
         # filling less has something sticking out (a red lamp on the tuning photos' motorbike passed as an ellipse)
@@ -156,8 +161,8 @@ class BlobMeasure:
             hue_off = self.colour.hue_off(unclipped_hue(hsv, mask, box, area, hue))
         half = (scale - 1) / 2.0  # a pixel's centre at half resolution lies between two at full resolution
         return Features(
-            (cx + x0) * scale + half, (cy + y0) * scale + half, size, arc, solidity, fill, elongation, sat, hue_off,
-            ring, ellipse_arc, edge,
+            (cx + x0) * scale + half, (cy + y0) * scale + half, size, arc, solidity, fill, elongation, box_fill, sat,
+            hue_off, ring, ellipse_arc, edge,
         )
 
     def _defer(self, later: tuple[MatLike, MatLike, MatLike, float, int, int, int, MatLike] | None,
@@ -185,7 +190,7 @@ class BlobMeasure:
     def _score(self, f: Features, width: int) -> float:
         shape = max(arc_score(f.arc, f.ellipse_arc), ramp(f.rim, *RIM)) if f.rim else arc_score(f.arc, f.ellipse_arc)
         shape *= ramp(f.solidity, *SOLIDITY) * ramp(f.fill, *FILL)
-        shape *= ramp(f.elongation, *ELONGATION) * self._size_score(f.size, width)
+        shape *= outline_score(f.elongation, f.box_fill, f.arc, f.size) * self._size_score(f.size, width)
         colour = ramp(f.saturation, self.colour.sat_lo + SATURATION[0], self.colour.sat_lo + SATURATION[1])
         colour *= 1.0 - ramp(f.hue_off, *HUE_OFF)
         return shape * colour * ramp(f.ring, *RING)

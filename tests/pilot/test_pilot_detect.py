@@ -143,6 +143,41 @@ def test_hsv_red_square_is_no_ball(angle: float) -> None:
     assert not d.found or d.confidence < 0.6, d
 
 
+@pytest.mark.parametrize("side,blur", [(16, 1.5), (18, 1.0), (20, 0.0), (20, 1.0), (24, 1.5)])
+@pytest.mark.parametrize("disc", [False, True])
+def test_hsv_small_square_blurred_round_is_no_ball_and_a_disc_is(side: int, blur: float, disc: bool) -> None:
+    """A small square at 45 degrees, blurred, fits its enclosing circle as well as a disc does (each of these scored
+    0.7-1.0 before the fill of its minimum-area rectangle was scored); a disc as wide, blurred alike, still scores 1."""
+    img = synth.background(320, 240)
+    if disc:
+        cv2.circle(img, (160 * 16, 120 * 16), side * 8, synth.RED, -1, cv2.LINE_AA, 4)
+    else:
+        box = cv2.boxPoints(((160.0, 120.0), (float(side), float(side)), 45.0))
+        cv2.fillPoly(img, [np.round(box * 16).astype(np.int32)], synth.RED, cv2.LINE_AA, 4)
+    if blur:
+        img = np.asarray(cv2.GaussianBlur(img, (0, 0), blur), np.uint8)
+    d = HsvBlobDetector(HsvConfig()).detect(img)
+    if disc:
+        assert d.found and d.confidence >= 0.95, d
+    else:
+        assert not d.found or d.confidence < 0.6, d
+
+
+@pytest.mark.parametrize("r", [20, 30])
+@pytest.mark.parametrize("side", [0.0, 60.0, 135.0, 200.0])
+def test_hsv_ball_partly_hidden_is_as_long_as_it_needs_to_be(r: int, side: float) -> None:
+    """A shaded ball with 30 % of it behind a grey object is 1.6 times longer than wide, and its outline keeps to its
+    circle: scored as a ball (0.74-0.83 when every blob 1.4 long or more was scored down)."""
+    ball = synth.matte_ball(synth.background(320, 240).astype(np.float64), 160.0, 120.0, r, (40.0, 40.0, 210.0), 0.6)
+    ux, uy = np.cos(np.radians(side)), np.sin(np.radians(side))
+    yy, xx = np.mgrid[0:240, 0:320]
+    along, across = (xx - 160) * ux + (yy - 120) * uy, (xx - 160) * uy - (yy - 120) * ux
+    ball[(along >= 0.325 * r) & (np.abs(across) <= 1.6 * r)] = (90.0, 100.0, 95.0)  # a chord 0.325 r out: 30 %
+    d = HsvBlobDetector(HsvConfig()).detect(np.clip(ball, 0, 255).astype(np.uint8))
+    assert d.found and d.confidence >= 0.9, d
+    assert abs(d.cx - 160.0) <= 2.0 and abs(d.cy - 120.0) <= 2.0, d
+
+
 @pytest.mark.parametrize(
     "hue,sat,lo,hi",
     [
