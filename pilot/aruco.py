@@ -10,6 +10,10 @@ blur and at the frame's edge, zero false positives, and a cost near OpenCV's def
 * A minimum perimeter in pixels (a side of ``MIN_SIDE_PX``): smaller quads cannot carry a readable 6x6
   cell grid, and the many tiny contours of a textured room are most of the default's cost.
 * ``polygonalApproxAccuracyRate`` 0.05 (default 0.03): a blurred or clipped marker's outline is rounder.
+* ``perspectiveRemovePixelPerCell`` 8 (default 4): each cell is read from 8x8 pixels of the unwarped marker, not
+  4x4; a cell blurred into its neighbours is read more surely (motion blur on the tuning photos' dev seeds: 85.5,
+  82.0, 76.0 -> 88.0, 88.0, 81.0 % of 200 markers; the frame's edge 83.5 -> 85.5 %; the same time per frame, no
+  false positive in 2,400 views; the ignored margin of each cell, 0.13 to 0.4, made no difference with it).
 * Sub-pixel corner refinement: the centre and the side (hence the range) to a fraction of a pixel.
 * A second look at half resolution when the full frame has no marker: motion blur halves with the image
   and the look costs a quarter of the first.
@@ -45,6 +49,7 @@ def detector_parameters(adaptive_thresh_constant: float, searched_width: int = 3
     params.adaptiveThreshWinSizeStep = 20
     params.minMarkerPerimeterRate = min(1.0, 4.0 * MIN_SIDE_PX / max(1, searched_width))
     params.polygonalApproxAccuracyRate = 0.05
+    params.perspectiveRemovePixelPerCell = 8
     params.minDistanceToBorder = 0
     params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
     params.cornerRefinementWinSize = 3
