@@ -99,7 +99,8 @@ class BlobMeasure:
         size = 2.0 * r * scale + 1.0 - (scale - 1)
         fill = area / (math.pi * r * r) if r > 0 else 0.0
         # the factors in the order that rejects soonest for least (bench/vision's frames): size and fill from the
-        # circle alone, then elongation, then the arcs (what most blobs that get that far fail), then the ring
+        # circle alone, then elongation (at most what a round outline may have), then the arcs (what most blobs that
+        # get that far fail) with the rectangle's aspect and fill, then the ring
         geometry = self._size_score(size, self._width) * ramp(fill, *FILL)
         if geometry <= 0.0 or geometry < least or (decide and fill < HALF_FILL):
             return None
