@@ -34,8 +34,9 @@ from .hsv_score import (
     SOLIDITY,
     Features,
     arc_score,
-    outline_score,
+    box_score,
     ramp,
+    stretch_score,
 )
 from .hsv_shape import ELLIPSE_ASPECT, RING_POINTS, ellipse_support, outer_rim, share_set
 
@@ -99,15 +100,16 @@ class BlobMeasure:
         size = 2.0 * r * scale + 1.0 - (scale - 1)
         fill = area / (math.pi * r * r) if r > 0 else 0.0
         # the factors in the order that rejects soonest for least (bench/vision's frames): size and fill from the
-        # circle alone, then elongation (at most what a round outline may have), then the arcs (what most blobs that
-        # get that far fail) with the rectangle's aspect and fill, then the ring
+        # circle alone, then the minimum-area rectangle's fill and aspect (at most what a round outline may have),
+        # then the arcs (what most blobs that get that far fail) with the aspect's own score, then the ring
         geometry = self._size_score(size, self._width) * ramp(fill, *FILL)
         if geometry <= 0.0 or geometry < least or (decide and fill < HALF_FILL):
             return None
         (_, _), (rw, rh), _ = cv2.minAreaRect(c)
         elongation = max(rw, rh) / max(1e-6, min(rw, rh))
         box_fill = area / max(1e-6, rw * rh)
-        most = geometry * ramp(elongation, *ELONGATION_ROUND)  # the rectangle's score depends on the arcs, to come
+        geometry *= box_score(box_fill, size)
+        most = geometry * ramp(elongation, *ELONGATION_ROUND)  # the aspect's score depends on the arcs, to come
         if most <= 0.0 or most < least:
             return None
         # what a rim look would need to measure it again, should its arcs or ring hold it down (a piece an opening
@@ -125,7 +127,7 @@ class BlobMeasure:
         arc = float(np.count_nonzero(on_arc)) / len(pts)
         if decide and arc < HALF_ARC:
             return None
-        geometry *= outline_score(elongation, box_fill, arc, size)
+        geometry *= stretch_score(elongation, arc)
         if geometry <= 0.0 or geometry < least:  # neither its rim nor its ring would lift it (no rim look)
             return None
         # an ellipse no longer than ELLIPSE_ASPECT fills 1 / ELLIPSE_ASPECT of its enclosing circle or more: a blob
@@ -191,7 +193,7 @@ class BlobMeasure:
     def _score(self, f: Features, width: int) -> float:
         shape = max(arc_score(f.arc, f.ellipse_arc), ramp(f.rim, *RIM)) if f.rim else arc_score(f.arc, f.ellipse_arc)
         shape *= ramp(f.solidity, *SOLIDITY) * ramp(f.fill, *FILL)
-        shape *= outline_score(f.elongation, f.box_fill, f.arc, f.size) * self._size_score(f.size, width)
+        shape *= stretch_score(f.elongation, f.arc) * box_score(f.box_fill, f.size) * self._size_score(f.size, width)
         colour = ramp(f.saturation, self.colour.sat_lo + SATURATION[0], self.colour.sat_lo + SATURATION[1])
         colour *= 1.0 - ramp(f.hue_off, *HUE_OFF)
         return shape * colour * ramp(f.ring, *RING)

@@ -56,11 +56,15 @@ def ramp(value: float, zero: float, one: float) -> float:
     return 0.0 if v <= 0.0 else 1.0 if v >= 1.0 else v
 
 
-def outline_score(elongation: float, box_fill: float, arc: float, size: float) -> float:
-    """The minimum-area rectangle's aspect and fill: a blob whose outline keeps to its circle (arcs scoring fully) may
-    be longer; a blob under ``BOX_FILL_FROM`` fills its rectangle whatever its shape."""
-    stretch = ramp(elongation, *(ELONGATION_ROUND if arc >= ARC[1] else ELONGATION))
-    return stretch * ramp(box_fill, *BOX_FILL) if size >= BOX_FILL_FROM else stretch
+def stretch_score(elongation: float, arc: float) -> float:
+    """The minimum-area rectangle's aspect: a blob whose outline keeps to its circle (arcs scoring fully) may be
+    longer."""
+    return ramp(elongation, *(ELONGATION_ROUND if arc >= ARC[1] else ELONGATION))
+
+
+def box_score(box_fill: float, size: float) -> float:
+    """The minimum-area rectangle's fill: a blob under ``BOX_FILL_FROM`` fills its rectangle whatever its shape."""
+    return ramp(box_fill, *BOX_FILL) if size >= BOX_FILL_FROM else 1.0
 
 
 def arc_score(arc: float, ellipse_arc: float) -> float:
