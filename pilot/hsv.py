@@ -46,7 +46,11 @@ high, keeping what scores ``SECOND_LOOK_MIN``: a ball's shaded side, or a ball i
 the bound (a lower bound for every frame joined dark red-brown surfaces to the balls on the tuning photos; steps 3
 and 4 in it too found a few balls more for 0.15x the floor more in bench/vision's median).
 
-A frame where nothing scores ``SECOND_LOOK_UNLESS`` after both looks gets a rim look (pilot/hsv_measure.py): the
+A noisy frame (pilot/hsv_noise.py: a camera's gain in dim light) where still nothing scores ``SECOND_LOOK_UNLESS``
+gets steps 1 and 2 again on the frame smoothed, keeping what scores ``SECOND_LOOK_MIN``: noise frays a dark ball's
+outline in the mask. The laser's aim check reads such a frame's centre smoothed too.
+
+A frame where nothing scores ``SECOND_LOOK_UNLESS`` after these looks gets a rim look (pilot/hsv_measure.py): the
 blobs that their arcs or ring held down are measured again with their rim support (pilot/hsv_rim.py), a brightness
 edge all round them, which stands in for the arcs (a mask frayed by JPEG's colour blocks, noise or shade) and for
 isolation (a ball on a surface of its colour). Pieces cut by edges under ``hsv_edges.MIN_SIZE`` count with a rim
@@ -79,9 +83,10 @@ from .hsv_circles import circle_features
 from .hsv_colour import Bounds, darker
 from .hsv_edges import MIN_SIZE, WALL_GROWTH, cut_by_edges, walled_in
 from .hsv_measure import HALF_DECIDES, BlobMeasure
+from .hsv_noise import NOISY, SMOOTH_SIGMA, noise_level, smoothed
 from .hsv_rim import rim_support
 from .hsv_score import SIZE, Features
-from .hsv_split import disc_centres, hue_split, round_pieces, split_off
+from .hsv_split import disc_centres, hue_pieces, split_off
 
 MAX_CANDIDATES = 4  # the largest search blobs refined; smaller ones cannot be the nearest target
 SEARCH_FILL = 0.45  # below FILL's zero: the search's coarser outline never rejects what the refinement keeps
@@ -91,7 +96,6 @@ HALF_MEASURE = 48  # px across (full resolution): a search blob this wide is mea
 SPLIT_FILL = 0.75  # a search blob filling less of its box's disc may be a ball joined to something
 SPLIT_BLOBS = 3  # the largest such blobs searched for discs
 SPLIT_PEAKS = 4  # disc centres refined per frame, widest first
-HUE_PIECES = 2  # the largest round pieces of each hue class refined
 EDGE_BLOBS = 2  # the largest search blobs cut by the image's edges
 HALF_TRY = 24  # px across: a smaller search blob is only refined; from this, first measured at half
 # resolution, where a plain disc scoring HALF_DECIDES (pilot/hsv_measure.py) skips the refinement
@@ -139,28 +143,43 @@ class HsvBlobDetector(BlobMeasure):
     # -- candidates ---------------------------------------------------------------------------------
     def features(self, image: MatLike) -> list[Features]:
         """Every refined blob's features (unscored): a second look with a lower V bound when the first found
-        nothing scoring ``SECOND_LOOK_UNLESS``, then a rim look when neither did."""
-        w, h = frame_size(image)
+        nothing scoring ``SECOND_LOOK_UNLESS``, a smoothed look in a noisy frame, a rim look and a circle look."""
+        w = frame_size(image)[0]
         self.new_frame(w)
         self._windows.clear()
         scale = 2 if w >= SEARCH_MIN_WIDTH else 1
-        small = cv2.resize(image, (w // scale, h // scale), interpolation=cv2.INTER_AREA) if scale > 1 else image
-        bounds = self.colour.bounds_for(small)  # the exposure read where the resize has just been: in cache
-        small_hsv = cv2.cvtColor(small, self.colour.code)
+        small, bounds, small_hsv = self._search(image, scale)
         found = self._look(image, bounds, small, small_hsv, scale)
         if self._enough(found, w):
             return found
         lower = darker(bounds, SECOND_LOOK_GAIN)
         if any(int(a[0][2]) != int(b[0][2]) for a, b in zip(lower, bounds, strict=True)):  # not at the floor
-            self.keep_from = SECOND_LOOK_MIN
-            more = self._look(image, lower, small, small_hsv, scale, splits=False)
-            found += [f for f in more if _new(f, found) and self.score(f, w) >= SECOND_LOOK_MIN]
+            found = self._again(image, lower, small, small_hsv, scale, found)
+            if self._enough(found, w):
+                return found
+        if (smooth := smoothed(image)) is not None:  # a noisy frame (pilot/hsv_noise.py)
+            s_small, s_bounds, s_hsv = self._search(smooth, scale)
+            found = self._again(smooth, s_bounds, s_small, s_hsv, scale, found)
             if self._enough(found, w):
                 return found
         found = self._rim_look(found)
         if self._enough(found, w):
             return found
         return found + self._circle_look(image, bounds, found)
+
+    def _search(self, image: MatLike, scale: int) -> tuple[MatLike, Bounds, MatLike]:
+        """The search's frame (``scale`` times smaller), its bounds for the frame's exposure, and its HSV."""
+        w, h = frame_size(image)
+        small = cv2.resize(image, (w // scale, h // scale), interpolation=cv2.INTER_AREA) if scale > 1 else image
+        bounds = self.colour.bounds_for(small)  # the exposure read where the resize has just been: in cache
+        return small, bounds, cv2.cvtColor(small, self.colour.code)
+
+    def _again(self, image: MatLike, bounds: Bounds, small: MatLike, small_hsv: MatLike, scale: int,
+               found: list[Features]) -> list[Features]:
+        """``found`` and what steps 1 and 2 find once more scoring ``SECOND_LOOK_MIN`` (a fallback look)."""
+        self.keep_from = SECOND_LOOK_MIN
+        more = self._look(image, bounds, small, small_hsv, scale, splits=False)
+        return found + [f for f in more if _new(f, found) and self.score(f, self._width) >= SECOND_LOOK_MIN]
 
     def _enough(self, found: list[Features], width: int) -> bool:
         """Whether a look found something the pilot would act on (no further look then)."""
@@ -272,27 +291,15 @@ class HsvBlobDetector(BlobMeasure):
 
     def _hue_split(self, image: MatLike, bounds: Bounds, hsv: MatLike, mask: MatLike,
                    joined: list[tuple[float, MatLike, Box]], scale: int, found: list[Features]) -> list[Features]:
-        """Balls a few hue units off what they are joined to (a red ball on a red-brown saucer): each joined
-        blob whose pixels fall in two hue classes is searched again in each class's hue range, and its round
-        pieces refined in that range (their rings then see only their own hue). One range only (pilot/hsv_colour.py)."""
-        ((lo, hi),) = bounds
+        """Balls a few hue units off what they are joined to (a red ball on a red-brown saucer): the round pieces
+        of each hue class of the largest joined blobs (pilot/hsv_split.py), refined in that class's range (their
+        rings then see only their own hue). One range only (pilot/hsv_colour.py)."""
         min_area = self.cfg.min_area / (scale * scale)
         out: list[Features] = []
-        for _, c, (x, y, bw, bh) in joined[:SPLIT_BLOBS]:
-            blob = np.zeros((bh, bw), np.uint8)
-            cv2.drawContours(blob, [c], -1, 255, -1, offset=(-x, -y))
-            window = np.asarray(hsv, np.uint8)[y : y + bh, x : x + bw]
-            blob &= np.asarray(mask, np.uint8)[y : y + bh, x : x + bw]
-            t = hue_split(np.ascontiguousarray(window[..., 0]), blob, 4 * min_area)
-            if t is None:
-                continue
-            for h0, h1 in ((int(lo[0]), t), (t + 1, int(hi[0]))):
-                sub_lo, sub_hi = lo.copy(), hi.copy()
-                sub_lo[0], sub_hi[0] = h0, h1
-                sub = self.colour.clean(cv2.bitwise_and(cv2.inRange(window, sub_lo, sub_hi), blob))
-                for _, (px, py, pw, ph) in round_pieces(sub, min_area, SEARCH_FILL)[:HUE_PIECES]:
-                    box = ((px + x) * scale, (py + y) * scale, pw * scale, ph * scale)
-                    out += [f for f in self._refine(image, [(sub_lo, sub_hi)], box) if _new(f, found + out)]
+        for sub, (px, py, pw, ph) in hue_pieces(hsv, mask, joined[:SPLIT_BLOBS], bounds, min_area, SEARCH_FILL,
+                                                self.colour.clean):
+            box = (px * scale, py * scale, pw * scale, ph * scale)
+            out += [f for f in self._refine(image, sub, box) if _new(f, found + out)]
         return out
 
     def _split(self, image: MatLike, bounds: Bounds, joined: list[tuple[float, MatLike, Box]],
@@ -390,4 +397,7 @@ class HsvBlobDetector(BlobMeasure):
         rim stays centred, and it reaches the window's edge a frame or two before the middle. The V bound is the
         closer look's (``NEAR_GAIN``): the ball it found in shade is in shade at its middle too."""
         r = max(2, min(round(AIM_SPAN * size / 2.0), image.shape[0] // 4))
-        return self.colour.centre_share(image, r, NEAR_GAIN) >= AIM_SHARE
+        if self.colour.centre_share(image, r, NEAR_GAIN) >= AIM_SHARE:
+            return True
+        # noise pushes a dark ball's pixels out of its colour: a noisy frame's window is read smoothed too
+        return noise_level(image) >= NOISY and self.colour.centre_share(image, r, NEAR_GAIN, SMOOTH_SIGMA) >= AIM_SHARE

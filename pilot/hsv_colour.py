@@ -9,6 +9,8 @@ that a ball's shaded side stays in the mask.
 
 from __future__ import annotations
 
+import math
+
 import cv2
 import numpy as np
 import numpy.typing as npt
@@ -106,10 +108,14 @@ class ColourMask:
         """The full-resolution mask (with the exposure-adapted V bound), as the refinement sees it."""
         return self.clean(self.raw(image, self.bounds_for(image)))
 
-    def centre_share(self, image: MatLike, r: int, gain: float) -> float:
+    def centre_share(self, image: MatLike, r: int, gain: float, smooth: float = 0.0) -> float:
         """The share of the (2 r + 1)-pixel square at the frame's centre that is of the target's colour (with the
-        frame's V bound ``gain`` times as high)."""
+        frame's V bound ``gain`` times as high), read after a Gaussian of ``smooth`` px if it is not 0."""
         h, w = image.shape[:2]
-        roi = image[h // 2 - r: h // 2 + r + 1, w // 2 - r: w // 2 + r + 1]
+        m = min(math.ceil(3.0 * smooth), h // 2 - r, w // 2 - r)  # the Gaussian's reach, within the frame
+        roi = image[h // 2 - r - m: h // 2 + r + m + 1, w // 2 - r - m: w // 2 + r + m + 1]
+        if smooth > 0.0:
+            roi = cv2.GaussianBlur(roi, (0, 0), smooth)
+        roi = roi[m: roi.shape[0] - m, m: roi.shape[1] - m]
         mask = self.raw(np.ascontiguousarray(roi), darker(self.bounds_for(image), gain))
         return cv2.countNonZero(mask) / mask.size

@@ -5,6 +5,7 @@ off the red-brown surface it lies on)."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterator, Sequence
 from typing import NamedTuple
 
 import cv2
@@ -12,6 +13,7 @@ import numpy as np
 import numpy.typing as npt
 from cv2.typing import MatLike
 
+from .hsv_colour import Bounds
 from .hsv_shape import unit_circle
 
 PEAK_MIN = 3.0  # pixels: a disc centre nearer than this to the blob's edge is too small to be a ball
@@ -20,6 +22,7 @@ RIM_MIN = 0.35  # of a circle just outside a disc that leaves the blob: less is 
 # fits inside a wide region has its nearest edge on one side); it halves the discs refined, not the recall
 SPLIT_OPEN = 0.5  # the opening's disc, in radii of the disc found (0.6 let opened squares through: red_shape)
 SPLIT_CUT = 0.1  # the opening must cut off this much (of the piece's area): else the blob was joined to nothing
+HUE_PIECES = 2  # the largest round pieces of each hue class refined
 HUE_GAP = 4.0  # hue units between the means of a blob's two hue classes (Otsu) for a split by hue (3: more
 # false detections on the tuning photos' empty views, 2: more still)
 
@@ -113,6 +116,28 @@ def hue_split(hue: npt.NDArray[np.uint8], blob: npt.NDArray[np.uint8], min_count
     if not len(low) or not len(high) or float(high.mean()) - float(low.mean()) < HUE_GAP:
         return None
     return int(t)
+
+
+def hue_pieces(hsv: MatLike, mask: MatLike, joined: Sequence[tuple[float, MatLike, Box]], bounds: Bounds,
+               min_area: float, min_fill: float, clean: Callable[[MatLike], MatLike]) -> Iterator[tuple[Bounds, Box]]:
+    """For each joined blob (area, contour, box in the search ``hsv`` and its ``mask``) whose pixels fall in two hue
+    classes: each class's hue range (``bounds``, one range, narrowed) and the ``HUE_PIECES`` largest round pieces of
+    the blob in it (their boxes in the search; ``clean``: the detector's mask cleaning)."""
+    ((lo, hi),) = bounds
+    for _, c, (x, y, bw, bh) in joined:
+        blob = np.zeros((bh, bw), np.uint8)
+        cv2.drawContours(blob, [c], -1, 255, -1, offset=(-x, -y))
+        window = np.asarray(hsv, np.uint8)[y : y + bh, x : x + bw]
+        blob &= np.asarray(mask, np.uint8)[y : y + bh, x : x + bw]
+        t = hue_split(np.ascontiguousarray(window[..., 0]), blob, 4 * min_area)
+        if t is None:
+            continue
+        for h0, h1 in ((int(lo[0]), t), (t + 1, int(hi[0]))):
+            sub_lo, sub_hi = lo.copy(), hi.copy()
+            sub_lo[0], sub_hi[0] = h0, h1
+            sub = clean(cv2.bitwise_and(cv2.inRange(window, sub_lo, sub_hi), blob))
+            for _, (px, py, pw, ph) in round_pieces(sub, min_area, min_fill)[:HUE_PIECES]:
+                yield [(sub_lo, sub_hi)], (px + x, py + y, pw, ph)
 
 
 def round_pieces(mask: MatLike, min_area: float, min_fill: float) -> list[tuple[float, Box]]:
