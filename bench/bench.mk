@@ -16,7 +16,8 @@
 #   make bench-flight     the closed-loop campaign in the MuJoCo simulator: seeded flights per detector across
 #                         every scenario, still air and gusts; success, non-target laser hits, crashes, the
 #                         simulator's cost per frame; writes bench/flight/RESULTS.md (BENCH_FLIGHT_FLAGS=--seeds 2
-#                         for a shorter one)
+#                         for a shorter one; "--detector hsv --first-seed 500 --seeds 4": seeds never tuned on,
+#                         bench/flight/RESULTS-hsv-from500.md)
 #   make bench            every part's benchmark: bench-protocol, bench-generator, bench-firmware
 #                         (firmware/firmware.mk), bench-pilot (pilot/pilot.mk), bench-vision, bench-ide
 #                         (bench/ide/bench.mk), bench-rust-c (tests/targets/targets.mk) and bench-tools
