@@ -44,11 +44,9 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
 A frame where nothing scores ``SECOND_LOOK_UNLESS`` gets a second look, steps 1 and 2 with the V bound 0.8 times as
 high, keeping what scores ``SECOND_LOOK_MIN``: a ball's shaded side, or a ball in dim or back light, falls below
 the bound (a lower bound for every frame joined dark red-brown surfaces to the balls on the tuning photos; steps 3
-and 4 in it too found a few balls more for 0.15x the floor more in bench/vision's median).
-
-A noisy frame (pilot/hsv_noise.py: a camera's gain in dim light) where still nothing scores ``SECOND_LOOK_UNLESS``
-gets steps 1 and 2 again on the frame smoothed, keeping what scores ``SECOND_LOOK_MIN``: noise frays a dark ball's
-outline in the mask. The laser's aim check reads such a frame's centre smoothed too.
+and 4 in it too found a few balls more for 0.15x the floor more in bench/vision's median). A noisy frame (a camera's
+gain in dim light: pilot/hsv_noise.py) then gets steps 1 and 2 again on the frame smoothed, keeping what scores as
+much: noise frays a dark ball's outline in the mask. The laser's aim check reads such a frame's centre smoothed too.
 
 A frame where nothing scores ``SECOND_LOOK_UNLESS`` after these looks gets a rim look (pilot/hsv_measure.py): the
 blobs that their arcs or ring held down are measured again with their rim support (pilot/hsv_rim.py), a brightness
