@@ -8,7 +8,8 @@
 #   make bench-generator  generator time for the shipped and a 676-command spec, rejecting hostile specs;
 #                         writes bench/generator/RESULTS.md
 #   make bench-vision     the detectors on real photographs (scikit-image's and scikit-learn's) under 10
-#                         conditions, empty and distractor views, tuning, held-out and validation photos, time vs
+#                         conditions (and a dark room at full gain, apart), empty and distractor views, tuning,
+#                         held-out and validation photos, time vs
 #                         the cvtColor+inRange floor; 400 views per condition, about 6 minutes on 2 cores;
 #                         writes bench/vision/RESULTS.md (BENCH_VISION_FLAGS=--quick for a smoke run)
 #   make bench-tools      the standalone codec wheel's size and import time vs json; the live view's frame

@@ -137,6 +137,7 @@ def main(argv: list[str] | None = None) -> int:
                 "", f"## HSV on the {name}: false detections", "", *false_table(hsv_rec, threshold),
                 "", f"## ArUco on the {name}", "", *target_table(aruco_rec, 0.5, 0),
                 "", *false_table(aruco_rec, 0.5)]
+    out += full_gain(n, threshold)
     out += gate_sweep(n)
     out += ["", "## Detection time per frame (median)", "", *timing(100 if args.quick else 400), ""]
     text = "\n".join(out)
@@ -144,6 +145,26 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_write:
         (HERE / "RESULTS.md").write_text(text, encoding="utf-8")
     return 0
+
+
+def full_gain(n: int, threshold: float) -> list[str]:
+    """HSV in a dark room at the camera's full gain (noise 10-20 per channel; pilot/hsv_noise.py), apart from the
+    conditions above: its own views, so theirs stay as they were."""
+    rows = ["", "## HSV in a dark room at full gain (no goal)", "",
+            "A quarter of the light, brightened 4 times, noise 10-20 per channel (bench/vision/vision_imagery.py's "
+            f"`{vi.FULL_GAIN}`; the simulator's `dim` room reaches 10-25): {n} target views and {n} empty views "
+            "per photo set, targets >= 16 px.", "",
+            "| photos | targets | recall | median error (px) | empty views with a detection |", "|---|---|---|---|---|"]
+    for name, split, seed in (("tuning", vi.TUNING, 7), ("held-out", vi.HELD_OUT, 8)):
+        views = ve.samples(split, seed, n, 0, 0, "ball", BALL_SIZES, (vi.FULL_GAIN,))
+        rng = np.random.default_rng(seed + 100)
+        views += [vi.Sample(vi.degrade(vi.view(rng, split), vi.FULL_GAIN, rng)[0], "empty", vi.FULL_GAIN)
+                  for _ in range(n)]
+        records = ve.run(HsvBlobDetector().detect, views)
+        (target,) = ve.target_rows(records, threshold, 16)
+        empty = ve.false_rows(records, threshold, "empty")[-1]
+        rows.append(f"| {name} | {target.n} | {pct(target.rate)} | {target.median_error:.2f} | {pct(empty.rate)} |")
+    return rows
 
 
 def gate_sweep(n: int) -> list[str]:

@@ -30,6 +30,7 @@ HELD_OUT = ("astronaut", "retina", "logo", "hubble_deep_field", "motorcycle_righ
 VALIDATION = ("china", "flower")  # sklearn.datasets' sample photos: a temple's red columns, an orange dahlia
 CONDITIONS = ("clean", "perspective", "gaussian_blur", "motion_blur", "jpeg", "dim", "bright", "warm", "noise",
               "occlusion")
+FULL_GAIN = "full_gain"  # a dark room at the camera's full gain (the simulator's `dim` room): reported apart, no goal
 DISTRACTOR_KINDS = ("orange", "pink", "red_brown", "red_shape", "red_poster")
 MARKER_DICT, MARKER_ID = cv2.aruco.DICT_4X4_50, 7
 
@@ -220,6 +221,9 @@ def degrade(img: Image, condition: str, rng: np.random.Generator) -> tuple[Image
         out = decoded
     elif condition == "dim":  # little light: a low gain and the noise that comes with it
         out = _noisy(np.asarray(cv2.convertScaleAbs(img, alpha=rng.uniform(0.35, 0.5)), np.uint8), 3.0, rng)
+    elif condition == "full_gain":  # a dark room: a quarter of the light, the camera's gain at 4 and its noise
+        dark = cv2.convertScaleAbs(img, alpha=0.25)
+        out = _noisy(np.asarray(cv2.convertScaleAbs(dark, alpha=4.0), np.uint8), rng.uniform(10.0, 20.0), rng)
     elif condition == "bright":
         out = cv2.convertScaleAbs(img, alpha=rng.uniform(1.4, 1.8))
     elif condition == "warm":  # tungsten light, about 3000 K, on a daylight white balance
