@@ -81,7 +81,7 @@ from .hsv_circles import circle_features
 from .hsv_colour import Bounds, darker
 from .hsv_edges import MIN_SIZE, WALL_GROWTH, cut_by_edges, walled_in
 from .hsv_measure import HALF_DECIDES, BlobMeasure
-from .hsv_noise import NOISY, SMOOTH_SIGMA, noise_level, smoothed
+from .hsv_noise import smoothed
 from .hsv_rim import rim_support
 from .hsv_score import SIZE, Features
 from .hsv_split import disc_centres, hue_pieces, split_off
@@ -395,7 +395,4 @@ class HsvBlobDetector(BlobMeasure):
         rim stays centred, and it reaches the window's edge a frame or two before the middle. The V bound is the
         closer look's (``NEAR_GAIN``): the ball it found in shade is in shade at its middle too."""
         r = max(2, min(round(AIM_SPAN * size / 2.0), image.shape[0] // 4))
-        if self.colour.centre_share(image, r, NEAR_GAIN) >= AIM_SHARE:
-            return True
-        # noise pushes a dark ball's pixels out of its colour: a noisy frame's window is read smoothed too
-        return noise_level(image) >= NOISY and self.colour.centre_share(image, r, NEAR_GAIN, SMOOTH_SIGMA) >= AIM_SHARE
+        return self.colour.centre_holds(image, r, NEAR_GAIN, AIM_SHARE)

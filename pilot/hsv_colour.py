@@ -18,6 +18,7 @@ from cv2.typing import MatLike
 
 from .config import HsvConfig
 from .errors import ConfigError
+from .hsv_noise import SMOOTH_SIGMA, noisy
 
 V_REFERENCE = 200  # brightness (see exposure) of a well-exposed frame; the V bound scales below it
 V_FLOOR = 24  # the V bound never drops below this: under it hue and saturation are noise
@@ -108,9 +109,16 @@ class ColourMask:
         """The full-resolution mask (with the exposure-adapted V bound), as the refinement sees it."""
         return self.clean(self.raw(image, self.bounds_for(image)))
 
-    def centre_share(self, image: MatLike, r: int, gain: float, smooth: float = 0.0) -> float:
-        """The share of the (2 r + 1)-pixel square at the frame's centre that is of the target's colour (with the
-        frame's V bound ``gain`` times as high), read after a Gaussian of ``smooth`` px if it is not 0."""
+    def centre_holds(self, image: MatLike, r: int, gain: float, share: float) -> bool:
+        """Whether at least ``share`` of the (2 r + 1)-pixel square at the frame's centre is of the target's colour
+        (with the frame's V bound ``gain`` times as high). Noise pushes a dark ball's pixels out of its colour: a
+        noisy frame's square (pilot/hsv_noise.py) that falls short is read smoothed too."""
+        if self._centre_share(image, r, gain, 0.0) >= share:
+            return True
+        return noisy(image) and self._centre_share(image, r, gain, SMOOTH_SIGMA) >= share
+
+    def _centre_share(self, image: MatLike, r: int, gain: float, smooth: float) -> float:
+        """The share of that square of the target's colour, read after a Gaussian of ``smooth`` px if not 0."""
         h, w = image.shape[:2]
         m = min(math.ceil(3.0 * smooth), h // 2 - r, w // 2 - r)  # the Gaussian's reach, within the frame
         roi = image[h // 2 - r - m: h // 2 + r + m + 1, w // 2 - r - m: w // 2 + r + m + 1]

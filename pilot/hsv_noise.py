@@ -35,8 +35,11 @@ def noise_level(image: MatLike) -> float:
     return _MAD_TO_SIGMA * median / 6.0
 
 
+def noisy(image: MatLike) -> bool:
+    """Whether the frame's noise is ``NOISY`` or more."""
+    return noise_level(image) >= NOISY
+
+
 def smoothed(image: MatLike) -> MatLike | None:
-    """The frame smoothed if it is noisy (``NOISY``), else None."""
-    if noise_level(image) < NOISY:
-        return None
-    return cv2.GaussianBlur(image, (0, 0), SMOOTH_SIGMA)
+    """The frame smoothed if it is noisy, else None."""
+    return cv2.GaussianBlur(image, (0, 0), SMOOTH_SIGMA) if noisy(image) else None

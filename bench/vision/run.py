@@ -158,8 +158,7 @@ def full_gain(n: int, threshold: float) -> list[str]:
     for name, split, seed in (("tuning", vi.TUNING, 7), ("held-out", vi.HELD_OUT, 8)):
         views = ve.samples(split, seed, n, 0, 0, "ball", BALL_SIZES, (vi.FULL_GAIN,))
         rng = np.random.default_rng(seed + 100)
-        views += [vi.Sample(vi.degrade(vi.view(rng, split), vi.FULL_GAIN, rng)[0], "empty", vi.FULL_GAIN)
-                  for _ in range(n)]
+        views += [vi.empty_sample(rng, split, vi.FULL_GAIN) for _ in range(n)]
         records = ve.run(HsvBlobDetector().detect, views)
         (target,) = ve.target_rows(records, threshold, 16)
         empty = ve.false_rows(records, threshold, "empty")[-1]

@@ -274,8 +274,10 @@ def target_sample(rng: np.random.Generator, photos: tuple[str, ...], condition: 
     return Sample(out, "target", condition, d, tx, ty)
 
 
-def empty_sample(rng: np.random.Generator, photos: tuple[str, ...]) -> Sample:
-    condition = CONDITIONS[int(rng.integers(len(CONDITIONS) - 1))]  # every condition but occlusion
+def empty_sample(rng: np.random.Generator, photos: tuple[str, ...], condition: str | None = None) -> Sample:
+    """A view with no target, under ``condition`` (by default any but occlusion, drawn from ``rng``)."""
+    if condition is None:
+        condition = CONDITIONS[int(rng.integers(len(CONDITIONS) - 1))]
     return Sample(degrade(view(rng, photos), condition, rng)[0], "empty", condition)
 
 

@@ -13,6 +13,7 @@ import vision_imagery as vi
 from pilot_synth import matte_ball
 
 import pilot.hsv as hsv_module
+import pilot.hsv_colour as hsv_colour
 from pilot.hsv import HsvBlobDetector
 from pilot.hsv_noise import NOISY, noise_level
 
@@ -77,7 +78,7 @@ def test_the_aim_check_reads_a_noisy_frame_smoothed(monkeypatch: pytest.MonkeyPa
     off = [dim_frame(seed, 15.0, ball=False)[0] for seed in range(8)]
     assert all(det.aim_on_target(f, 22.0) for f in on)
     assert not any(det.aim_on_target(f, 22.0) for f in off)
-    monkeypatch.setattr(hsv_module, "noise_level", lambda image: 0.0)  # read as it is: noise hides the ball's middle
+    monkeypatch.setattr(hsv_colour, "noisy", lambda image: False)  # read as it is: noise hides the ball's middle
     assert not any(det.aim_on_target(f, 22.0) for f in on)
 
 
@@ -86,8 +87,7 @@ def test_real_photos_in_a_dark_room_at_full_gain(monkeypatch: pytest.MonkeyPatch
     full-gain views): most balls found, more than without the smoothed look, nothing in the empty views."""
     views = ve.samples(vi.TUNING, 17, 150, 0, 0, "ball", (16.0, 120.0), (vi.FULL_GAIN,))
     rng = np.random.default_rng(18)
-    views += [vi.Sample(vi.degrade(vi.view(rng, vi.TUNING), vi.FULL_GAIN, rng)[0], "empty", vi.FULL_GAIN)
-              for _ in range(60)]
+    views += [vi.empty_sample(rng, vi.TUNING, vi.FULL_GAIN) for _ in range(60)]
 
     def rates() -> tuple[float, float]:
         records = ve.run(HsvBlobDetector().detect, views)
