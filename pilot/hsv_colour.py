@@ -4,7 +4,8 @@
 Red wraps around hue 0, which would need two ranges; converting the BGR frame as if it were RGB mirrors the hue
 circle (h -> 120 - h, in OpenCV's 0..179 units) and puts red at 120, in one piece. The value (V) bound follows the
 frame's exposure: in a frame whose brightest pixels are dim, it drops in proportion (never below ``V_FLOOR``), so
-that a ball's shaded side stays in the mask.
+that a ball's shaded side stays in the mask. ``Grown`` bounds (the detector's second look) also take the pixels of
+the target's hue and saturation down to ``V_FLOOR`` that touch the mask.
 """
 
 from __future__ import annotations
@@ -39,6 +40,36 @@ def darker(bounds: Bounds, gain: float) -> Bounds:
         adapted[2] = max(min(int(lo[2]), V_FLOOR), round(int(lo[2]) * gain))
         out.append((adapted, hi))
     return out
+
+
+def _in_range(hsv: MatLike, bounds: Bounds) -> MatLike:
+    mask = cv2.inRange(hsv, bounds[0][0], bounds[0][1])
+    for lo, hi in bounds[1:]:
+        mask = cv2.bitwise_or(mask, cv2.inRange(hsv, lo, hi))
+    return mask
+
+
+class Grown(list[tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]]):
+    """Bounds whose mask grows, as Canny's two thresholds do: the pixels of the target's hue and saturation with V
+    down to ``V_FLOOR`` join it where they touch it. A ball's shaded side joins its lit side; a dark surface of
+    its colour stays out unless something over the bound lies on it. One lower V bound for every pixel, as a look
+    once had, joined dark red-brown surfaces to the balls on the tuning photos of bench/vision."""
+
+    def mask(self, hsv: MatLike) -> MatLike:
+        core = _in_range(hsv, self)
+        n, labels = cv2.connectedComponents(_in_range(hsv, darker(self, 0.0)), connectivity=8)
+        keep = np.zeros(n, np.uint8)
+        keep[labels[np.asarray(core) > 0]] = 255  # the dark pieces holding a pixel of the core
+        keep[0] = 0
+        return np.take(keep, np.asarray(labels))
+
+
+def grown(bounds: Bounds, gain: float) -> Grown | None:
+    """``bounds`` ``gain`` times as dark (see ``darker``), grown; None if they are at ``V_FLOOR`` already (the mask
+    would be theirs)."""
+    if all(int(lo[2]) <= V_FLOOR for lo, _ in bounds):
+        return None
+    return Grown(darker(bounds, gain))
 
 
 class ColourMask:
@@ -94,10 +125,7 @@ class ColourMask:
 
     @staticmethod
     def in_range(hsv: MatLike, bounds: Bounds) -> MatLike:
-        mask = cv2.inRange(hsv, bounds[0][0], bounds[0][1])
-        for lo, hi in bounds[1:]:
-            mask = cv2.bitwise_or(mask, cv2.inRange(hsv, lo, hi))
-        return mask
+        return bounds.mask(hsv) if isinstance(bounds, Grown) else _in_range(hsv, bounds)
 
     def clean(self, mask: MatLike) -> MatLike:
         if self.kernel is None:
