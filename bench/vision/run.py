@@ -134,6 +134,8 @@ def main(argv: list[str] | None = None) -> int:
                                        ("validation photos", val)):
         out += ["", f"## HSV on the {name}: targets >= 16 px", "", *target_table(hsv_rec, threshold, 16),
                 "", f"Targets 10-15 px (no goal): recall {pct(_small(hsv_rec, threshold))}.",
+                "", "By photo, every condition but occlusion: " + ", ".join(
+                    f"{r.group} {pct(r.rate)} of {r.n}" for r in ve.photo_rows(hsv_rec, threshold, 16)) + ".",
                 "", f"## HSV on the {name}: false detections", "", *false_table(hsv_rec, threshold),
                 "", f"## ArUco on the {name}", "", *target_table(aruco_rec, 0.5, 0),
                 "", *false_table(aruco_rec, 0.5)]

@@ -30,6 +30,7 @@ class Record:
     found: bool
     confidence: float
     error: float  # pixels from the truth (targets), inf when nothing was found
+    photo: str = ""  # the photo the view is cut from (targets)
 
 
 def samples(split: tuple[str, ...], seed: int, per_condition: int, empty: int, per_distractor: int,
@@ -47,7 +48,7 @@ def run(detect: Detect, views: list[vi.Sample]) -> list[Record]:
     for s in views:
         d = detect(s.image)
         err = math.hypot(d.cx - s.cx, d.cy - s.cy) if d.found and s.kind == "target" else math.inf
-        records.append(Record(s.kind, s.condition, s.size, d.found, d.confidence if d.found else 0.0, err))
+        records.append(Record(s.kind, s.condition, s.size, d.found, d.confidence if d.found else 0.0, err, s.photo))
     return records
 
 
@@ -78,6 +79,16 @@ def target_rows(records: list[Record], threshold: float, min_size: float) -> lis
         med = statistics.median(errs) if errs else math.nan
         p95 = errs[min(len(errs) - 1, int(0.95 * len(errs)))] if errs else math.nan
         rows.append(Row(g, len(rs), len(ok) / len(rs) if rs else math.nan, med, p95))
+    return rows
+
+
+def photo_rows(records: list[Record], threshold: float, min_size: float) -> list[Row]:
+    """Recall per photo over every condition but occlusion: where the misses are."""
+    rs = [r for r in records if r.kind == "target" and r.group != "occlusion" and r.size >= min_size]
+    rows = []
+    for name in sorted(dict.fromkeys(r.photo for r in rs)):
+        mine = [r for r in rs if r.photo == name]
+        rows.append(Row(name, len(mine), sum(1 for r in mine if correct(r, threshold)) / len(mine)))
     return rows
 
 

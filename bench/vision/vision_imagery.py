@@ -59,7 +59,13 @@ def photo(name: str) -> Image:
 
 def view(rng: np.random.Generator, photos: tuple[str, ...]) -> Image:
     """A random 4:3 crop (35-100 % of the photo's shorter side), resized to the camera's 320x240."""
-    src = photo(photos[int(rng.integers(len(photos)))])
+    return named_view(rng, photos)[1]
+
+
+def named_view(rng: np.random.Generator, photos: tuple[str, ...]) -> tuple[str, Image]:
+    """``view``, and the name of the photo it is cut from."""
+    name = photos[int(rng.integers(len(photos)))]
+    src = photo(name)
     h, w = src.shape[:2]
     ch = int(min(h, w * 3 / 4) * rng.uniform(0.35, 1.0))
     cw = ch * 4 // 3
@@ -67,7 +73,7 @@ def view(rng: np.random.Generator, photos: tuple[str, ...]) -> Image:
     crop = src[y : y + ch, x : x + cw]
     if rng.random() < 0.5:
         crop = crop[:, ::-1]
-    return np.asarray(cv2.resize(crop, (W, H), interpolation=cv2.INTER_AREA), np.uint8)
+    return name, np.asarray(cv2.resize(crop, (W, H), interpolation=cv2.INTER_AREA), np.uint8)
 
 
 def _disc_alpha(cx: float, cy: float, r: float, shape: tuple[int, int]) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -250,11 +256,12 @@ class Sample:
     size: float = 0.0  # target diameter (ball) or black side (marker), pixels
     cx: float = 0.0
     cy: float = 0.0
+    photo: str = ""  # the photo the view is cut from (target views)
 
 
 def target_sample(rng: np.random.Generator, photos: tuple[str, ...], condition: str, target: str,
                   sizes: tuple[float, float], edge: bool = False) -> Sample:
-    img = view(rng, photos)
+    name, img = named_view(rng, photos)
     d = float(np.exp(rng.uniform(math.log(sizes[0]), math.log(sizes[1]))))
     half = d / 2 if target == "ball" else d * 0.75
     # edge: the marker's black square touching the frame's left or right edge
@@ -271,7 +278,7 @@ def target_sample(rng: np.random.Generator, photos: tuple[str, ...], condition: 
             occlude(img, cx, cy, d * 1.414, 0.3, rng)
     out, hm = degrade(img, "clean" if condition in ("occlusion", "edge") else condition, rng)
     tx, ty = map_point(hm, cx, cy)
-    return Sample(out, "target", condition, d, tx, ty)
+    return Sample(out, "target", condition, d, tx, ty, name)
 
 
 def empty_sample(rng: np.random.Generator, photos: tuple[str, ...], condition: str | None = None) -> Sample:

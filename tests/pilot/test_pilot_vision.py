@@ -149,6 +149,12 @@ def test_real_photos_hsv_floors(small_eval: tuple[list[ve.Record], list[ve.Recor
     assert sum(rows.values()) / len(rows) >= 0.75  # 0.84 reached (0.78 before the split and the ellipse)
     assert ve.false_rows(hsv, threshold, "empty")[-1].rate <= 0.02  # at most 1 of 60 (none now)
     assert ve.false_rows(hsv, threshold, "distractor")[-1].rate <= 0.05  # at most 2 of 40 (none now)
+    # the recall by photo covers the same views, every condition but occlusion
+    by_photo = ve.photo_rows(hsv, threshold, 16)
+    counted = [r for r in hsv if r.kind == "target" and r.group != "occlusion" and r.size >= 16]
+    assert {r.group for r in by_photo} == {r.photo for r in counted} and set(vi.TUNING) >= {r.group for r in by_photo}
+    assert sum(r.n for r in by_photo) == len(counted)
+    assert sum(round(r.rate * r.n) for r in by_photo) == sum(ve.correct(r, threshold) for r in counted)
 
 
 def test_real_photos_hsv_stays_quiet_in_red_and_orange_scenes() -> None:
