@@ -69,11 +69,13 @@ class Row:
     p95_error: float = math.nan
 
 
-def target_rows(records: list[Record], threshold: float, min_size: float) -> list[Row]:
+def target_rows(records: list[Record], threshold: float, min_size: float,
+                by: Callable[[Record], str] = lambda r: r.group) -> list[Row]:
+    """Recall and position error per condition (or per what ``by`` names), in the order first met."""
     rows = []
-    groups = dict.fromkeys(r.group for r in records if r.kind == "target")
+    groups = dict.fromkeys(by(r) for r in records if r.kind == "target")
     for g in groups:
-        rs = [r for r in records if r.kind == "target" and r.group == g and r.size >= min_size]
+        rs = [r for r in records if r.kind == "target" and by(r) == g and r.size >= min_size]
         ok = [r for r in rs if correct(r, threshold)]
         errs = sorted(r.error for r in ok)
         med = statistics.median(errs) if errs else math.nan
@@ -84,12 +86,9 @@ def target_rows(records: list[Record], threshold: float, min_size: float) -> lis
 
 def photo_rows(records: list[Record], threshold: float, min_size: float) -> list[Row]:
     """Recall per photo over every condition but occlusion: where the misses are."""
-    rs = [r for r in records if r.kind == "target" and r.group != "occlusion" and r.size >= min_size]
-    rows = []
-    for name in sorted(dict.fromkeys(r.photo for r in rs)):
-        mine = [r for r in rs if r.photo == name]
-        rows.append(Row(name, len(mine), sum(1 for r in mine if correct(r, threshold)) / len(mine)))
-    return rows
+    kept = [r for r in records if r.group != "occlusion" and r.size >= min_size]  # a photo with none: no row
+    rows = target_rows(kept, threshold, min_size, by=lambda r: r.photo)
+    return sorted(rows, key=lambda row: row.group)
 
 
 def false_rows(records: list[Record], threshold: float, kind: str) -> list[Row]:
