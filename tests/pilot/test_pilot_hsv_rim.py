@@ -11,6 +11,7 @@ import pytest
 
 import pilot.hsv as hsv
 import pilot.hsv_measure as hsv_measure
+import pilot.hsv_rim as hsv_rim
 from pilot.hsv_rim import rim_support
 from pilot.hsv_score import RIM
 
@@ -79,3 +80,18 @@ def test_the_rim_does_not_make_a_red_square_a_ball() -> None:
     cv2.rectangle(img, (CX - 16, CY - 16), (CX + 16, CY + 16), RED, -1)
     found = hsv.HsvBlobDetector().candidates(img)
     assert not found or found[0].score < 0.6
+
+
+def test_a_wide_blurred_rim_is_measured_at_half_resolution(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A 60 px ball blurred (sigma 4 px) has a rim that is a ramp, too gentle for a 3x3 Sobel at full resolution;
+    halved, it is an edge all round, while a square blurred alike still shows only its sides' middles."""
+    grey, ball = (120, 120, 120), (40, 40, 160)  # BGR: 44 grey levels apart
+    sharp_disc = np.full((240, 320, 3), grey, np.uint8)
+    cv2.circle(sharp_disc, (CX, CY), 30, ball, -1, cv2.LINE_AA)
+    sharp_square = np.full((240, 320, 3), grey, np.uint8)
+    cv2.rectangle(sharp_square, (CX - 30, CY - 30), (CX + 30, CY + 30), ball, -1)
+    disc, square = cv2.GaussianBlur(sharp_disc, (0, 0), 4.0), cv2.GaussianBlur(sharp_square, (0, 0), 4.0)
+    assert rim_support(disc, CX, CY, 30.0) >= 0.95
+    assert max(rim_support(square, CX, CY, 30.0), rim_support(square, CX, CY, 30.0 * 1.414)) < RIM[0]
+    monkeypatch.setattr(hsv_rim, "HALF_FROM", 1e9)  # at full resolution only
+    assert rim_support(disc, CX, CY, 30.0) < RIM[0]
