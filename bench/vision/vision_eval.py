@@ -3,7 +3,9 @@
 A detection counts at or above a confidence threshold (the pilot's ``controller.acquire_confidence``);
 on a target view it is correct within max(3 px, 30 % of the target's size) of the truth, and a
 detection anywhere else is a miss. Records keep every confidence, so one pass serves a whole threshold
-sweep.
+sweep. They also keep whether any candidate the detector reported lay at the truth: the recall a better
+ranking of the same candidates could reach at most, which tells a miss of the score from a miss of the
+candidates.
 """
 
 from __future__ import annotations
@@ -12,14 +14,19 @@ import math
 import statistics
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 import vision_imagery as vi
 from cv2.typing import MatLike
 
-from pilot.detection import Detection
+from pilot.detection import Candidate
 
-Detect = Callable[[MatLike], Detection]
+
+class Source(Protocol):
+    """What the evaluation needs of a detector (pilot.detection.CandidateSource has it)."""
+
+    def candidates(self, image: MatLike) -> list[Candidate]: ...
 
 
 @dataclass(frozen=True)
@@ -31,6 +38,7 @@ class Record:
     confidence: float
     error: float  # pixels from the truth (targets), inf when nothing was found
     photo: str = ""  # the photo the view is cut from (targets)
+    reached: bool = False  # a candidate, whatever its score, lay at the truth (targets)
 
 
 def samples(split: tuple[str, ...], seed: int, per_condition: int, empty: int, per_distractor: int,
@@ -43,17 +51,29 @@ def samples(split: tuple[str, ...], seed: int, per_condition: int, empty: int, p
     return out
 
 
-def run(detect: Detect, views: list[vi.Sample]) -> list[Record]:
+def run(source: Source, views: list[vi.Sample]) -> list[Record]:
+    """Each view's best candidate (as the detector's ``detect`` reports it) and whether any lay at the truth."""
     records = []
     for s in views:
-        d = detect(s.image)
-        err = math.hypot(d.cx - s.cx, d.cy - s.cy) if d.found and s.kind == "target" else math.inf
-        records.append(Record(s.kind, s.condition, s.size, d.found, d.confidence if d.found else 0.0, err, s.photo))
+        cands = source.candidates(s.image)
+        best = cands[0] if cands else None
+        err = math.hypot(best.cx - s.cx, best.cy - s.cy) if best and s.kind == "target" else math.inf
+        reached = s.kind == "target" and any(_at(c, s) for c in cands)
+        records.append(Record(s.kind, s.condition, s.size, best is not None, best.score if best else 0.0, err,
+                              s.photo, reached))
     return records
 
 
+def _at(c: Candidate, s: vi.Sample) -> bool:
+    return math.hypot(c.cx - s.cx, c.cy - s.cy) <= _tolerance(s.size)
+
+
+def _tolerance(size: float) -> float:
+    return max(3.0, 0.3 * size)
+
+
 def correct(r: Record, threshold: float) -> bool:
-    return r.found and r.confidence >= threshold and r.error <= max(3.0, 0.3 * r.size)
+    return r.found and r.confidence >= threshold and r.error <= _tolerance(r.size)
 
 
 def detected(r: Record, threshold: float) -> bool:
@@ -67,6 +87,7 @@ class Row:
     rate: float  # recall (targets) or share of views with a detection (empty, distractor)
     median_error: float = math.nan
     p95_error: float = math.nan
+    reached: float = math.nan  # share of targets with a candidate at the truth
 
 
 def target_rows(records: list[Record], threshold: float, min_size: float,
@@ -80,7 +101,8 @@ def target_rows(records: list[Record], threshold: float, min_size: float,
         errs = sorted(r.error for r in ok)
         med = statistics.median(errs) if errs else math.nan
         p95 = errs[min(len(errs) - 1, int(0.95 * len(errs)))] if errs else math.nan
-        rows.append(Row(g, len(rs), len(ok) / len(rs) if rs else math.nan, med, p95))
+        reached = sum(1 for r in rs if r.reached) / len(rs) if rs else math.nan
+        rows.append(Row(g, len(rs), len(ok) / len(rs) if rs else math.nan, med, p95, reached))
     return rows
 
 
