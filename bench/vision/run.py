@@ -99,9 +99,9 @@ def times(frames: list[vi.Image], repeat: int, *fns: Callable[[vi.Image], object
 def evaluate(split: tuple[str, ...], seed: int, n: int) -> tuple[list[ve.Record], list[ve.Record]]:
     ball = ve.samples(split, seed, n, 5 * n, n // 2, "ball", BALL_SIZES, vi.CONDITIONS)
     markers = ve.samples(split, seed + 1, n, 0, 0, "marker", MARKER_SIZES, ARUCO_CONDITIONS)
-    hsv_records = ve.run(HsvBlobDetector(), ball)
+    hsv_records = ve.run(HsvBlobDetector().candidates, ball)
     negatives = [s for s in ball if s.kind != "target"]
-    aruco_records = ve.run(ArucoMarkerDetector(), markers + negatives)
+    aruco_records = ve.run(ArucoMarkerDetector().candidates, markers + negatives)
     return hsv_records, aruco_records
 
 
@@ -164,7 +164,7 @@ def full_gain(n: int, threshold: float) -> list[str]:
         views = ve.samples(split, seed, n, 0, 0, "ball", BALL_SIZES, (vi.FULL_GAIN,))
         rng = np.random.default_rng(seed + 100)
         views += [vi.empty_sample(rng, split, vi.FULL_GAIN) for _ in range(n)]
-        records = ve.run(HsvBlobDetector(), views)
+        records = ve.run(HsvBlobDetector().candidates, views)
         (target,) = ve.target_rows(records, threshold, 16)
         empty = ve.false_rows(records, threshold, "empty")[-1]
         rows.append(f"| {name} | {target.n} | {pct(target.rate)} | {target.median_error:.2f} | {pct(empty.rate)} |")

@@ -14,7 +14,6 @@ import math
 import statistics
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from typing import Protocol
 
 import numpy as np
 import vision_imagery as vi
@@ -22,11 +21,7 @@ from cv2.typing import MatLike
 
 from pilot.detection import Candidate
 
-
-class Source(Protocol):
-    """What the evaluation needs of a detector (pilot.detection.CandidateSource has it)."""
-
-    def candidates(self, image: MatLike) -> list[Candidate]: ...
+Candidates = Callable[[MatLike], list[Candidate]]  # a detector's every candidate in a frame, best first
 
 
 @dataclass(frozen=True)
@@ -51,11 +46,11 @@ def samples(split: tuple[str, ...], seed: int, per_condition: int, empty: int, p
     return out
 
 
-def run(source: Source, views: list[vi.Sample]) -> list[Record]:
+def run(candidates: Candidates, views: list[vi.Sample]) -> list[Record]:
     """Each view's best candidate (as the detector's ``detect`` reports it) and whether any lay at the truth."""
     records = []
     for s in views:
-        cands = source.candidates(s.image)
+        cands = candidates(s.image)
         best = cands[0] if cands else None
         err = math.hypot(best.cx - s.cx, best.cy - s.cy) if best and s.kind == "target" else math.inf
         reached = s.kind == "target" and any(_at(c, s) for c in cands)

@@ -90,7 +90,7 @@ def test_real_photos_in_a_dark_room_at_full_gain(monkeypatch: pytest.MonkeyPatch
     views += [vi.empty_sample(rng, vi.TUNING, vi.FULL_GAIN) for _ in range(60)]
 
     def rates() -> tuple[float, float]:
-        records = ve.run(HsvBlobDetector(), views)
+        records = ve.run(HsvBlobDetector().candidates, views)
         return ve.target_rows(records, 0.6, 16)[0].rate, ve.false_rows(records, 0.6, "empty")[-1].rate
 
     recall, empty = rates()

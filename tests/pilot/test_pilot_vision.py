@@ -119,17 +119,12 @@ def small_eval() -> tuple[list[ve.Record], list[ve.Record]]:
     ball = ve.samples(vi.TUNING, 11, 12, 60, 8, "ball", (16.0, 120.0), vi.CONDITIONS)
     markers = ve.samples(vi.TUNING, 12, 12, 0, 0, "marker", (24.0, 120.0), ("clean", "motion_blur"))
     negatives = [s for s in ball if s.kind != "target"]
-    return ve.run(HsvBlobDetector(), ball), ve.run(ArucoMarkerDetector(), markers + negatives)
+    return ve.run(HsvBlobDetector().candidates, ball), ve.run(ArucoMarkerDetector().candidates, markers + negatives)
 
 
-class _Scripted:
+def _scripted(cands: list[Candidate]) -> ve.Candidates:
     """A detector returning a fixed list of candidates, whatever the frame."""
-
-    def __init__(self, cands: list[Candidate]) -> None:
-        self.cands = cands
-
-    def candidates(self, image: object) -> list[Candidate]:
-        return self.cands
+    return lambda image: cands
 
 
 def test_evaluation_tells_a_miss_of_the_score_from_a_miss_of_the_candidates() -> None:
@@ -138,13 +133,13 @@ def test_evaluation_tells_a_miss_of_the_score_from_a_miss_of_the_candidates() ->
     img = np.zeros((240, 320, 3), np.uint8)
     ball = vi.Sample(img, "target", "clean", 40.0, 100.0, 80.0, "coffee")
     wrong, right = Candidate(250.0, 200.0, 40.0, 0.9), Candidate(104.0, 83.0, 38.0, 0.4)
-    (second,) = ve.run(_Scripted([wrong, right]), [ball])
+    (second,) = ve.run(_scripted([wrong, right]), [ball])
     assert second.found and second.confidence == 0.9 and not ve.correct(second, 0.6) and second.reached
-    (none,) = ve.run(_Scripted([wrong]), [ball])
+    (none,) = ve.run(_scripted([wrong]), [ball])
     assert none.found and not none.reached
-    (best,) = ve.run(_Scripted([right]), [ball])
+    (best,) = ve.run(_scripted([right]), [ball])
     assert ve.correct(best, 0.3) and best.reached and best.error == pytest.approx(5.0)
-    (empty,) = ve.run(_Scripted([right]), [vi.Sample(img, "empty", "clean")])
+    (empty,) = ve.run(_scripted([right]), [vi.Sample(img, "empty", "clean")])
     assert empty.found and not empty.reached
     rows = ve.target_rows([second, none], 0.6, 16)
     assert rows[0].rate == 0.0 and rows[0].reached == 0.5
@@ -164,7 +159,7 @@ def test_real_photos_aruco_reads_markers_through_motion_blur() -> None:
     """A regression floor on 200 markers under motion blur (tuning photos; a seed of its own): 88 % are read with
     each cell read from 8x8 pixels of the unwarped marker, 82 % with OpenCV's 4x4 (goal: >= 80 %)."""
     markers = ve.samples(vi.TUNING, 22, 200, 0, 0, "marker", (24.0, 120.0), ("motion_blur",))
-    rows = {r.group: r.rate for r in ve.target_rows(ve.run(ArucoMarkerDetector(), markers), 0.5, 0)}
+    rows = {r.group: r.rate for r in ve.target_rows(ve.run(ArucoMarkerDetector().candidates, markers), 0.5, 0)}
     assert rows["motion_blur"] >= 0.86
 
 
@@ -192,6 +187,6 @@ def test_real_photos_hsv_stays_quiet_in_red_and_orange_scenes() -> None:
     empty views there fire the detector far more often than elsewhere. A regression floor: 6 of these 300 fire
     now, 12 did before the circle look's checks for hollows and textures (pilot/hsv_circles.py)."""
     views = ve.samples(vi.VALIDATION, 15, 0, 300, 0, "ball", (16.0, 120.0), ())
-    empty = ve.false_rows(ve.run(HsvBlobDetector(), views), ControllerConfig().acquire_confidence, "empty")
+    empty = ve.false_rows(ve.run(HsvBlobDetector().candidates, views), ControllerConfig().acquire_confidence, "empty")
     assert empty[-1].group == "all" and empty[-1].n == 300
     assert empty[-1].rate <= 9 / 300
