@@ -70,6 +70,26 @@ def test_the_votes_find_a_drawn_circle() -> None:
     assert inside_share(mask, 5.0, 5.0, 20.0) == 0.0  # reaching out of the window
 
 
+def test_a_wide_circle_is_checked_among_many_small_ones(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A wide ball with half its rim an edge, in a window of small bright spots: ranked together, the spots' small
+    circles take every place checked; each octave of radii has places of its own."""
+    grey = np.full((160, 200), 60, np.uint8)
+    cv2.circle(grey, (100, 80), 45, 120, -1, cv2.LINE_AA)
+    cv2.rectangle(grey, (100, 0), (200, 160), 120, -1)  # the right half of its rim: no edge
+    for x, y in ((20, 20), (20, 60), (20, 100), (20, 140), (60, 140), (150, 20), (150, 140), (180, 80), (140, 60)):
+        cv2.circle(grey, (x, y), 7, 220, -1, cv2.LINE_AA)
+    mask = np.full(grey.shape, 255, np.uint8)
+
+    def wide(found: list[tuple[float, float, float]]) -> list[float]:
+        return [r for cx, cy, r in found if math.hypot(cx - 100, cy - 80) <= 3.0]
+
+    found = centres(grey, mask, 80.0)
+    assert len(found) <= 3 * hsv_circles.PER_BAND and wide(found) and abs(wide(found)[0] - 45) <= 0.15 * 45
+    monkeypatch.setattr(hsv_circles, "BANDS", ())  # one band: the six best over all radii
+    monkeypatch.setattr(hsv_circles, "PER_BAND", 6)
+    assert not wide(centres(grey, mask, 80.0))
+
+
 def test_no_votes_no_circles() -> None:
     flat = np.full((40, 40), 120, np.uint8)
     assert centres(flat, np.full((40, 40), 255, np.uint8), 20.0) == []  # no edges
