@@ -27,6 +27,8 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
      wall does not.
    * size: the range the apparent diameter implies (known diameter, field of view) must be plausible, and
      a blob under 18 px is scored down (too few pixels to show its shape).
+   * texture: a blob with several round search blobs of its size close around it scores 0, whatever else it
+     shows (pilot/hsv_texture.py: a flower's cups, a polka-dot print).
 
    The circle, not the blob's centroid, gives the position: a ball's dark side or a covered part moves
    a centroid, not the circle through its rim.
@@ -128,8 +130,6 @@ class HsvBlobDetector(BlobMeasure):
         self, config: HsvConfig | None = None, vision: VisionConfig | None = None, fov_deg: float = 60.0
     ) -> None:
         super().__init__(config or HsvConfig(), vision or VisionConfig(), fov_deg)
-        self._blobs: list[tuple[float, MatLike, Box]] = []  # the first look's search blobs, for the circle look...
-        self._scale = 1  # ...and how much smaller than the frame the search is
         self._windows: dict[Box, tuple[Bounds, MatLike, MatLike, MatLike]] = {}  # this frame's blob windows
 
     @property
@@ -188,8 +188,8 @@ class HsvBlobDetector(BlobMeasure):
     def _circle_look(self, image: MatLike, bounds: Bounds, found: list[Features]) -> list[Features]:
         """The circles in the first look's largest blobs' windows (pilot/hsv_circles.py)."""
         out: list[Features] = []
-        k = self._scale
-        for _, _, (x, y, bw, bh) in sorted(self._blobs, key=lambda b: b[0], reverse=True)[:CIRCLE_BLOBS]:
+        k = self.search_scale
+        for _, _, (x, y, bw, bh) in sorted(self.search, key=lambda b: b[0], reverse=True)[:CIRCLE_BLOBS]:
             if max(bw, bh) * k < SIZE[1]:
                 continue
             x0, y0, roi, hsv, mask = self._blob_window(image, bounds, (x * k, y * k, bw * k, bh * k))
@@ -236,8 +236,8 @@ class HsvBlobDetector(BlobMeasure):
             if area < SPLIT_FILL * disc:
                 joined.append((area, c, box))
         boxes.sort(key=lambda b: b[0], reverse=True)
-        if splits:  # the first look's blobs: where the circle look would search
-            self._blobs, self._scale = blobs, scale
+        if splits:  # the first look's blobs: the texture around a blob, and where the circle look would search
+            self.search, self.search_scale = blobs, scale
         found: list[Features] = []
         for area, c, (x, y, bw, bh) in boxes[:MAX_CANDIDATES]:
             across = max(bw, bh) * scale if scale > 1 else 0  # searched at full resolution: refined as it is

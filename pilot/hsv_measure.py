@@ -39,6 +39,7 @@ from .hsv_score import (
     stretch_score,
 )
 from .hsv_shape import ELLIPSE_ASPECT, RING_POINTS, ellipse_support, outer_rim, share_set
+from .hsv_texture import SearchBlob, textured
 
 HALF_DECIDES = 0.9  # the half-resolution score that keeps a blob from the refinement...
 HALF_FILL = 0.8  # ...for a plain disc only: this fill of its circle (a square's is 0.64)...
@@ -78,6 +79,8 @@ class BlobMeasure:
         self._scores: dict[int, tuple[Features, int, float]] = {}  # id -> the blob (kept alive), width, score
         self.deferred: list[Deferred] = []  # this frame's blobs held down by their arcs or ring
         self.keep_from = 0.0  # the score a deferred blob must reach (a fallback look asks for more)
+        self.search: list[SearchBlob] = []  # the frame's search blobs (the first look's), for the texture check...
+        self.search_scale = 1  # ...and how much smaller than the frame the search is
 
     def new_frame(self, width: int) -> None:
         self._width = width
@@ -196,7 +199,8 @@ class BlobMeasure:
         shape *= stretch_score(f.elongation, f.arc) * box_score(f.box_fill, f.size) * self._size_score(f.size, width)
         colour = ramp(f.saturation, self.colour.sat_lo + SATURATION[0], self.colour.sat_lo + SATURATION[1])
         colour *= 1.0 - ramp(f.hue_off, *HUE_OFF)
-        return shape * colour * ramp(f.ring, *RING)
+        s = shape * colour * ramp(f.ring, *RING)
+        return 0.0 if s > 0.0 and textured(f.cx, f.cy, f.size, self.search, self.search_scale) else s
 
 
 _CORE = np.ones((3, 3), np.uint8)
