@@ -6,7 +6,9 @@ the ones that need ``pooch`` to download are not used). The split is fixed here,
 was chosen: the detectors are tuned on ``TUNING`` and only reported on ``HELD_OUT``. ``VALIDATION``, the two
 photos in scikit-learn's wheel, came later: scenes red and orange through and through, where the detector
 fired on 4.8 % of empty views; the circle look's checks were then chosen on them and the tuning photos
-(pilot/hsv_circles.py), so they are reported apart, and are not held out.
+(pilot/hsv_circles.py), so they are reported apart, and are not held out. ``BENCH``, the four photographs of an
+electronics bench in avr-libc's manual (Debian's ``avr-libc``, which the firmware build installs: a board with red
+push-buttons, red sockets and red wires), joined last, after every threshold was chosen: held out like ``HELD_OUT``.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cache
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -28,6 +31,8 @@ W, H = 320, 240
 TUNING = ("chelsea", "coffee", "rocket", "immunohistochemistry", "colorwheel", "motorcycle_left", "brick")
 HELD_OUT = ("astronaut", "retina", "logo", "hubble_deep_field", "motorcycle_right", "gravel")
 VALIDATION = ("china", "flower")  # sklearn.datasets' sample photos: a temple's red columns, an orange dahlia
+BENCH = ("largedemo-setup", "largedemo-wiring", "largedemo-wiring2", "stdiodemo-setup")  # avr-libc's manual
+BENCH_DIR = Path("/usr/share/doc/avr-libc/avr-libc-user-manual")
 CONDITIONS = ("clean", "perspective", "gaussian_blur", "motion_blur", "jpeg", "dim", "bright", "warm", "noise",
               "occlusion")
 FULL_GAIN = "full_gain"  # a dark room at the camera's full gain (the simulator's `dim` room): reported apart, no goal
@@ -40,6 +45,11 @@ def photo(name: str) -> Image:
     """A photograph as BGR uint8 (motorcycle_left/right: the two views of skimage's stereo pair)."""
     import skimage.data
 
+    if name in BENCH:
+        bgr = cv2.imread(str(BENCH_DIR / f"{name}.jpg"))
+        if bgr is None:
+            raise FileNotFoundError(f"{BENCH_DIR / name}.jpg: install Debian's avr-libc (make deps)")
+        return np.asarray(bgr, np.uint8)
     if name in VALIDATION:
         from sklearn.datasets import load_sample_image
 
