@@ -27,8 +27,7 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
      wall does not.
    * size: the range the apparent diameter implies (known diameter, field of view) must be plausible, and
      a blob under 18 px is scored down (too few pixels to show its shape).
-   * texture: a blob with several round search blobs of its size close around it scores 0, whatever else it
-     shows (pilot/hsv_texture.py: a flower's cups, a polka-dot print).
+   * texture: a blob with round search blobs of its size close around it scores 0 (pilot/hsv_texture.py).
 
    The circle, not the blob's centroid, gives the position: a ball's dark side or a covered part moves
    a centroid, not the circle through its rim.
@@ -90,6 +89,7 @@ from .hsv_noise import smoothed
 from .hsv_rim import rim_support
 from .hsv_score import SIZE, Features
 from .hsv_split import disc_centres, hue_pieces, split_off
+from .hsv_texture import SearchBlob
 
 MAX_CANDIDATES = 4  # the largest search blobs refined; smaller ones cannot be the nearest target
 SEARCH_FILL = 0.45  # below FILL's zero: the search's coarser outline never rejects what the refinement keeps
@@ -130,6 +130,7 @@ class HsvBlobDetector(BlobMeasure):
         self, config: HsvConfig | None = None, vision: VisionConfig | None = None, fov_deg: float = 60.0
     ) -> None:
         super().__init__(config or HsvConfig(), vision or VisionConfig(), fov_deg)
+        self._blobs: list[SearchBlob] = []  # the first look's search blobs, where the circle look searches
         self._windows: dict[Box, tuple[Bounds, MatLike, MatLike, MatLike]] = {}  # this frame's blob windows
 
     @property
@@ -189,7 +190,7 @@ class HsvBlobDetector(BlobMeasure):
         """The circles in the first look's largest blobs' windows (pilot/hsv_circles.py)."""
         out: list[Features] = []
         k = self.search_scale
-        for _, _, (x, y, bw, bh) in sorted(self.search, key=lambda b: b[0], reverse=True)[:CIRCLE_BLOBS]:
+        for _, _, (x, y, bw, bh) in sorted(self._blobs, key=lambda b: b[0], reverse=True)[:CIRCLE_BLOBS]:
             if max(bw, bh) * k < SIZE[1]:
                 continue
             x0, y0, roi, hsv, mask = self._blob_window(image, bounds, (x * k, y * k, bw * k, bh * k))
@@ -220,9 +221,9 @@ class HsvBlobDetector(BlobMeasure):
         # every point kept: a blob measured on the search needs them for its arcs
         contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
         min_area = self.cfg.min_area / (scale * scale)
-        boxes: list[tuple[float, MatLike, Box]] = []
-        joined: list[tuple[float, MatLike, Box]] = []
-        blobs: list[tuple[float, MatLike, Box]] = []
+        boxes: list[SearchBlob] = []
+        joined: list[SearchBlob] = []
+        blobs: list[SearchBlob] = []
         for c in contours:
             if len(c) < 6 or (area := cv2.contourArea(c)) < min_area:
                 continue
@@ -236,8 +237,8 @@ class HsvBlobDetector(BlobMeasure):
             if area < SPLIT_FILL * disc:
                 joined.append((area, c, box))
         boxes.sort(key=lambda b: b[0], reverse=True)
-        if splits:  # the first look's blobs: the texture around a blob, and where the circle look would search
-            self.search, self.search_scale = blobs, scale
+        if splits:  # the first look's blobs: where the circle look would search, and the round ones a texture
+            self._blobs, self.round_search, self.search_scale = blobs, boxes, scale
         found: list[Features] = []
         for area, c, (x, y, bw, bh) in boxes[:MAX_CANDIDATES]:
             across = max(bw, bh) * scale if scale > 1 else 0  # searched at full resolution: refined as it is
@@ -266,7 +267,7 @@ class HsvBlobDetector(BlobMeasure):
             found += self._edge_split(image, bounds, blobs, scale, found)
         return found
 
-    def _edge_split(self, image: MatLike, bounds: Bounds, blobs: list[tuple[float, MatLike, Box]],
+    def _edge_split(self, image: MatLike, bounds: Bounds, blobs: list[SearchBlob],
                     scale: int, found: list[Features]) -> list[Features]:
         """Balls on a surface of their colour: the largest search blobs' windows cut by the image's edges, the
         round pieces measured alone, their ring replaced by the share of their rim not walled in."""
@@ -290,7 +291,7 @@ class HsvBlobDetector(BlobMeasure):
         return out
 
     def _hue_split(self, image: MatLike, bounds: Bounds, hsv: MatLike, mask: MatLike,
-                   joined: list[tuple[float, MatLike, Box]], scale: int, found: list[Features]) -> list[Features]:
+                   joined: list[SearchBlob], scale: int, found: list[Features]) -> list[Features]:
         """Balls a few hue units off what they are joined to (a red ball on a red-brown saucer): the round pieces
         of each hue class of the largest joined blobs (pilot/hsv_split.py), refined in that class's range (their
         rings then see only their own hue). One range only (pilot/hsv_colour.py)."""
@@ -302,7 +303,7 @@ class HsvBlobDetector(BlobMeasure):
             out += [f for f in self._refine(image, sub, box) if _new(f, found + out)]
         return out
 
-    def _split(self, image: MatLike, bounds: Bounds, joined: list[tuple[float, MatLike, Box]],
+    def _split(self, image: MatLike, bounds: Bounds, joined: list[SearchBlob],
                scale: int, found: list[Features]) -> list[Features]:
         """Balls joined to something of their colour: the widest discs of the largest joined blobs, refined."""
         centres = sorted((p for _, c, box in joined[:SPLIT_BLOBS] for p in disc_centres(c, box)), reverse=True)

@@ -79,7 +79,8 @@ class BlobMeasure:
         self._scores: dict[int, tuple[Features, int, float]] = {}  # id -> the blob (kept alive), width, score
         self.deferred: list[Deferred] = []  # this frame's blobs held down by their arcs or ring
         self.keep_from = 0.0  # the score a deferred blob must reach (a fallback look asks for more)
-        self.search: list[SearchBlob] = []  # the frame's search blobs (the first look's), for the texture check...
+        self.round_search: list[SearchBlob] = []  # the frame's round search blobs (the first look's, those filling
+        # SEARCH_FILL of their box's disc, as a ball does), for the texture check...
         self.search_scale = 1  # ...and how much smaller than the frame the search is
 
     def new_frame(self, width: int) -> None:
@@ -200,7 +201,7 @@ class BlobMeasure:
         colour = ramp(f.saturation, self.colour.sat_lo + SATURATION[0], self.colour.sat_lo + SATURATION[1])
         colour *= 1.0 - ramp(f.hue_off, *HUE_OFF)
         s = shape * colour * ramp(f.ring, *RING)
-        return 0.0 if s > 0.0 and textured(f.cx, f.cy, f.size, self.search, self.search_scale) else s
+        return 0.0 if s > 0.0 and textured(f.cx, f.cy, f.size, self.round_search, self.search_scale) else s
 
 
 _CORE = np.ones((3, 3), np.uint8)

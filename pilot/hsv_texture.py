@@ -6,13 +6,13 @@ corner, with fewer than ``PEERS`` neighbours in reach, is not caught by it.
 
 Chosen on the dev seeds of the tuning and validation photos (bench/vision's own seeds and the held-out photos were
 not used): the validation photos' empty views with a detection 30 -> 17 of 600, distractor views 38 -> 28 of 600,
-the same balls found on the tuning photos (3,400) and one more on the validation photos (800). Peers of any shape
-(no ``PEER_FILL``) took a shiny saucer's noisy pieces for a texture round a ball: 1.5 points fewer balls under noise.
+the same balls found on the tuning photos (3,400) and one more on the validation photos (800). The peers are the
+search's round blobs (pilot/hsv.py's ``SEARCH_FILL``: those it would refine as a ball); counted of any shape, a shiny
+saucer's noisy pieces made a texture round a ball: 1.5 points fewer balls under noise.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 from cv2.typing import MatLike
@@ -21,23 +21,20 @@ PEERS = 4  # this many blobs of a similar size nearby make a texture
 SIZE_RATIO = 1.5  # a peer is at most this many times larger or smaller
 REACH = 4.0  # diameters from the blob's centre to a peer's
 OWN = 0.6  # diameters: a search blob whose centre is this close is the blob itself
-PEER_FILL = 0.45  # a peer fills this share of its box's disc: round, as a ball's blob (a shiny saucer's noisy pieces
-# around a ball are not)
 
 SearchBlob = tuple[float, MatLike, tuple[int, int, int, int]]  # area, contour, box (x, y, width, height)
 
 
 def textured(cx: float, cy: float, size: float, blobs: Sequence[SearchBlob], scale: int) -> bool:
-    """Whether a blob ``size`` px across at (cx, cy) (full resolution) has ``PEERS`` search blobs of a similar size
-    within ``REACH`` diameters; ``blobs`` are the search's, ``scale`` times smaller than the frame."""
-    if len(blobs) <= PEERS:
+    """Whether a blob ``size`` px across at (cx, cy) (full resolution) has ``PEERS`` of ``blobs`` of a similar size
+    within ``REACH`` diameters; ``blobs`` are the search's round ones, ``scale`` times smaller than the frame."""
+    if len(blobs) < PEERS:  # too few to hold the peers
         return False
     lo, hi = size / SIZE_RATIO, size * SIZE_RATIO
     near, own = (REACH * size) ** 2, (OWN * size) ** 2
     peers = 0
-    for area, _, (x, y, bw, bh) in blobs:
-        across = max(bw, bh)
-        if not lo <= across * scale <= hi or area < PEER_FILL * math.pi * across * across / 4.0:
+    for _, _, (x, y, bw, bh) in blobs:
+        if not lo <= max(bw, bh) * scale <= hi:
             continue
         d2 = ((x + bw / 2.0) * scale - cx) ** 2 + ((y + bh / 2.0) * scale - cy) ** 2
         if own <= d2 <= near:
