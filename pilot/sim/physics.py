@@ -78,6 +78,7 @@ class Airframe:
         self.airframe_geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "airframe")
         self.target_geoms = [i for i in range(model.ngeom)
                              if (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, i) or "").startswith("target_")]
+        self._target_contype = model.geom_contype[self.target_geoms].copy()  # restored when it shows again
         self._hidden = False
         self._on_floor = True
         self._tipped = False
@@ -156,7 +157,7 @@ class Airframe:
         if hidden != self._hidden:
             self._hidden = hidden
             self.model.geom_group[self.target_geoms] = HIDDEN_GROUP if hidden else 0
-            self.model.geom_contype[self.target_geoms] = 0 if hidden else 1
+            self.model.geom_contype[self.target_geoms] = 0 if hidden else self._target_contype
 
     def _score_contacts(self) -> None:
         d, st = self.data, self.state

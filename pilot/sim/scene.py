@@ -40,11 +40,15 @@ def motor_positions(arm: float) -> list[tuple[float, float]]:
 
 
 def _wall_plane(name: str, x: float, y: float, z: float, normal_heading: float, half: tuple[float, float],
-                material: str, offset: float = 0.0) -> str:
-    """A plane facing into the room (its normal along ``normal_heading``); x axis = up x normal."""
+                material: str, offset: float = 0.0, solid: bool = True) -> str:
+    """A plane facing into the room (its normal along ``normal_heading``); x axis = up x normal. MuJoCo collides
+    with a plane as an infinite half-space, whatever its size (which is only drawn): a plane that is not
+    ``solid`` (a picture on a wall, the marker on its backing board) is seen and hit by the laser's ray, never
+    touched. A solid marker plane made the whole room behind the target a wall."""
     nx, ny = math.cos(normal_heading), math.sin(normal_heading)
+    touch = "" if solid else ' contype="0" conaffinity="0"'
     return (f'<geom name="{name}" type="plane" pos="{_f(x + offset * nx, y + offset * ny, z)}" '
-            f'xyaxes="{_f(-ny, nx, 0, 0, 0, 1)}" size="{_f(half[0], half[1], 0.1)}" material="{material}"/>')
+            f'xyaxes="{_f(-ny, nx, 0, 0, 0, 1)}" size="{_f(half[0], half[1], 0.1)}" material="{material}"{touch}/>')
 
 
 class _Writer:
@@ -72,7 +76,7 @@ class _Writer:
         mat = self.photo_material(p.texture) if p.texture else self.colour_material(f"mat_{name}", p.rgb)
         if p.shape == "poster":
             return _wall_plane(name, p.position[0], p.position[1], p.position[2], p.yaw, (p.size[0], p.size[1]),
-                               mat, offset=0.01)
+                               mat, offset=0.01, solid=False)
         size = {"box": p.size, "sphere": p.size[:1], "cylinder": p.size[:2]}[p.shape]
         return (f'<geom name="{name}" type="{p.shape}" pos="{_f(*p.position)}" quat="{_yaw_quat(p.yaw)}" '
                 f'size="{_f(*size)}" material="{mat}"/>')
@@ -118,7 +122,7 @@ def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg
         f = plate.facing
         # in front of the pole (radius 0.015): a pole across the marker's border would hide it from the detector
         target_geoms.append(_wall_plane("target_marker", 0.0, 0.0, plate.centre[2], f, (half, half), "marker",
-                                        offset=0.032))
+                                        offset=0.032, solid=False))  # the backing board is what a drone touches
         bx, by = 0.022 * math.cos(f), 0.022 * math.sin(f)
         target_geoms.append(f'<geom name="target_backing" type="box" pos="{_f(bx, by, plate.centre[2])}" '
                             f'quat="{_yaw_quat(f)}" size="{_f(0.008, half, half)}" material="{pole}"/>')
@@ -185,4 +189,4 @@ def _window(w: _Writer, sc: Scenario) -> str:
     on_x_wall = abs(t - ts[0]) < 1e-9  # the line meets a wall of constant x first
     heading = (math.pi if dx > 0 else 0.0) if on_x_wall else (-math.pi / 2 if dy > 0 else math.pi / 2)
     mat = w.colour_material("window", (1.0, 0.98, 0.92), emission=2.5)
-    return _wall_plane("window", x, y, 1.6, heading, (1.0, 0.8), mat, offset=0.02)
+    return _wall_plane("window", x, y, 1.6, heading, (1.0, 0.8), mat, offset=0.02, solid=False)

@@ -11,6 +11,7 @@ import pytest
 from sim_rig import ALT_HOLD, CH, MEDIANS, PARAMS, STABILIZE, Rig
 
 from pilot.detect import HsvBlobDetector
+from pilot.sim import mj
 from pilot.sim.arducopter import FlightController, Mode, Sensors, desired_climb_rate, desired_lean
 from pilot.sim.camera import CameraModel, rolling_shutter
 from pilot.sim.room import SCENARIOS, make_scenario
@@ -226,3 +227,39 @@ def test_the_firmware_landing_routine_disarms_the_flight_controller_from_under_t
     assert rig.af.state.z < 0.02
     rig.run(dp.ARMING_HOLD_MS / 1000.0, throttle=CH["throttle"].minimum, yaw=CH["yaw"].minimum)
     assert not rig.af.fc.armed
+
+
+def _touches(rig: Rig, x: float, y: float, z: float) -> set[str]:
+    """What the airframe, put at (x, y, z), is in contact with."""
+    mujoco = mj.module()
+    rig.data.qpos[:3] = (x, y, z)
+    mujoco.mj_forward(rig.model, rig.data)
+    names = set()
+    for c in rig.data.contact[: rig.data.ncon]:
+        pair = (int(c.geom1), int(c.geom2))
+        if rig.af.airframe_geom in pair:
+            other = pair[0] if pair[1] == rig.af.airframe_geom else pair[1]
+            names.add(mujoco.mj_id2name(rig.model, mujoco.mjtObj.mjOBJ_GEOM, other))
+    return names
+
+
+def test_the_marker_plate_and_the_pictures_are_touched_only_where_they_are() -> None:
+    """MuJoCo collides with a plane as an infinite half-space: the marker's plane once made a wall of the whole
+    room behind the target. Beside the plate along its plane, and behind it, there is nothing; at the plate, its
+    backing board."""
+    rig = Rig("ahead", 0)
+    sc = rig.af.sc
+    assert sc.marker is not None
+    px, py, pz = sc.marker.centre
+    along = (-math.sin(sc.marker.facing), math.cos(sc.marker.facing))  # in the plate's plane, horizontal
+    normal = (math.cos(sc.marker.facing), math.sin(sc.marker.facing))
+    for k in (-1.0, 1.0):  # 1.5 m to each side of the plate, in its plane
+        x, y = px + 1.5 * k * along[0], py + 1.5 * k * along[1]
+        if sc.room.inside(x, y, 0.4):
+            assert _touches(rig, x, y, pz) == set()
+    behind = (px - 1.0 * normal[0], py - 1.0 * normal[1])
+    if sc.room.inside(*behind, 0.4):
+        assert _touches(rig, *behind, pz) == set()
+    # the airframe's front edge reaching the board
+    reach = PARAMS.airframe.radius_m + 0.02
+    assert "target_backing" in _touches(rig, px + reach * normal[0], py + reach * normal[1], pz)
