@@ -16,6 +16,8 @@ from .room import Prop, Scenario
 DRONE_GROUP = 3
 HIDDEN_GROUP = 4
 CAMERA_POS = (0.23, 0.0, -0.03)  # on the airframe's nose, below the arms
+ZNEAR = 0.001  # the camera's near clipping plane, in the room's extents (about 1 cm): at MuJoCo's 0.01 (11 cm), a
+# wall within 9 cm of the airframe's nose vanished, and the camera saw the black outside the room
 MOTOR_SPIN = (1, -1, 1, -1)  # front-left, front-right... alternating directions cancel the reaction torque
 
 
@@ -148,6 +150,7 @@ def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg
     <global offwidth="{width}" offheight="{height}"/>
     <headlight ambient="{_f(amb, amb, amb)}" diffuse="0 0 0" specular="0 0 0"/>
     <quality shadowsize="0" offsamples="0"/>
+    <map znear="{ZNEAR}"/>
   </visual>
   <asset>
     {chr(10).join('    ' + m for m in w.materials).strip()}

@@ -263,3 +263,15 @@ def test_the_marker_plate_and_the_pictures_are_touched_only_where_they_are() -> 
     # the airframe's front edge reaching the board
     reach = PARAMS.airframe.radius_m + 0.02
     assert "target_backing" in _touches(rig, px + reach * normal[0], py + reach * normal[1], pz)
+
+
+def test_a_camera_against_a_wall_sees_the_wall_not_the_void_behind_it() -> None:
+    """The airframe's nose touching the west wall (x = 0) puts the camera 2 cm from it: inside MuJoCo's default
+    near plane (11 cm here), the wall was clipped away and the frame black, which the pilot reads as a dead
+    camera."""
+    sc = make_scenario("ahead", 0)
+    view = StillView(sc, CameraModel(320, 240))
+    view.place(PARAMS.airframe.radius_m + 0.005, sc.room.depth / 2, 1.2, math.pi)  # facing the wall, nose on it
+    frame = view.render(1.0)
+    view.close()
+    assert float(frame.mean()) > 40.0  # the lit wall (a black frame: under 12)
