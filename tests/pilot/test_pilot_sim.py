@@ -253,13 +253,11 @@ def test_the_marker_plate_and_the_pictures_are_touched_only_where_they_are() -> 
     px, py, pz = sc.marker.centre
     along = (-math.sin(sc.marker.facing), math.cos(sc.marker.facing))  # in the plate's plane, horizontal
     normal = (math.cos(sc.marker.facing), math.sin(sc.marker.facing))
-    for k in (-1.0, 1.0):  # 1.5 m to each side of the plate, in its plane
-        x, y = px + 1.5 * k * along[0], py + 1.5 * k * along[1]
-        if sc.room.inside(x, y, 0.4):
-            assert _touches(rig, x, y, pz) == set()
+    beside = [(px + 1.5 * k * along[0], py + 1.5 * k * along[1]) for k in (-1.0, 1.0)]  # 1.5 m off, in its plane
     behind = (px - 1.0 * normal[0], py - 1.0 * normal[1])
-    if sc.room.inside(*behind, 0.4):
-        assert _touches(rig, *behind, pz) == set()
+    for x, y in (*beside, behind):
+        assert sc.room.inside(x, y, 0.4)  # clear of the walls, so that any contact is the plate's
+        assert _touches(rig, x, y, pz) == set()
     # the airframe's front edge reaching the board
     reach = PARAMS.airframe.radius_m + 0.02
     assert "target_backing" in _touches(rig, px + reach * normal[0], py + reach * normal[1], pz)
