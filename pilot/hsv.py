@@ -6,11 +6,11 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
 1. Search: the frame at half resolution (from 320 px wide up; a 16 px target is still 8 px there),
    one ``cvtColor``, one ``inRange``, a 3x3 opening, external contours. The ranges as the fewest ``inRange``
    calls (red in one piece) and the V bound that follows the frame's exposure are ``pilot.hsv_colour``.
-2. Refine: the few largest blobs filling at least ``SEARCH_FILL`` of their box's disc are looked at again at
-   full resolution, in a window around each: a 3x3 median (sensor noise in a ball's shaded side would fray
-   its outline), mask, 3x3 opening and closing, the blob's contours, and a score 0..1 each, a product of
-   ramps each between a value no target shows and one every target shows (chosen on the tuning photos of
-   bench/vision); measuring stops as soon as the product so far is below ``hsv.min_score``:
+2. Refine (pilot/hsv_refine.py, as are steps 3 and 4): the few largest blobs filling at least ``SEARCH_FILL`` of
+   their box's disc are looked at again at full resolution, in a window around each: a 3x3 median (sensor noise
+   in a ball's shaded side would fray its outline), mask, 3x3 opening and closing, the blob's contours, and a
+   score 0..1 each, a product of ramps each between a value no target shows and one every target shows (chosen
+   on the tuning photos of bench/vision); measuring stops as soon as the product so far is below ``hsv.min_score``:
 
    * shape: the share of the contour lying on its minimum enclosing circle ("arc support": a disk ~1, a
      disk with 30 % hidden behind an edge ~0.7, a square ~0.3) or, where that is low, on an ellipse fitted
@@ -56,7 +56,7 @@ A frame where nothing scores ``SECOND_LOOK_UNLESS`` after these looks gets a rim
 blobs that their arcs or ring held down are measured again with their rim support (pilot/hsv_rim.py), a brightness
 edge all round them, which stands in for the arcs (a mask frayed by JPEG's colour blocks, noise or shade) and for
 isolation (a ball on a surface of its colour). Pieces cut by edges under ``hsv_edges.MIN_SIZE`` count with a rim
-of ``SMALL_RIM``.
+of ``hsv_refine.SMALL_RIM``.
 
 A frame where still nothing scores ``SECOND_LOOK_UNLESS`` gets a circle look (pilot/hsv_circles.py): in the first
 look's ``CIRCLE_BLOBS`` largest blobs' windows, circles of brightness edges (the best of each octave of radii) with
@@ -76,30 +76,22 @@ from __future__ import annotations
 import math
 
 import cv2
-import numpy as np
 from cv2.typing import MatLike
 
 from .config import HsvConfig, VisionConfig
 from .detection import Candidate, Detection, best_detection, frame_size
 from .hsv_circles import circle_features
 from .hsv_colour import Bounds, darker, grown
-from .hsv_edges import MIN_SIZE, WALL_GROWTH, cut_by_edges, walled_in
-from .hsv_measure import HALF_DECIDES, BlobMeasure
+from .hsv_measure import HALF_DECIDES
 from .hsv_noise import smoothed
-from .hsv_rim import rim_support
+from .hsv_refine import SEARCH_FILL, WindowRefiner, is_new
 from .hsv_score import SIZE, Features
-from .hsv_split import disc_centres, hue_pieces, split_off
 from .hsv_texture import SearchBlob
 
 MAX_CANDIDATES = 4  # the largest search blobs refined; smaller ones cannot be the nearest target
-SEARCH_FILL = 0.45  # below FILL's zero: the search's coarser outline never rejects what the refinement keeps
-BLOBS_PER_BOX = 2  # blobs measured in one search blob's window (noise can join two at half resolution)
 SEARCH_MIN_WIDTH = 320  # frames at least this wide are searched at half resolution
 HALF_MEASURE = 48  # px across (full resolution): a search blob this wide is measured at half resolution
 SPLIT_FILL = 0.75  # a search blob filling less of its box's disc may be a ball joined to something
-SPLIT_BLOBS = 3  # the largest such blobs searched for discs
-SPLIT_PEAKS = 4  # disc centres refined per frame, widest first
-EDGE_BLOBS = 2  # the largest search blobs cut by the image's edges
 HALF_TRY = 24  # px across: a smaller search blob is only refined; from this, first measured at half
 # resolution, where a plain disc scoring HALF_DECIDES (pilot/hsv_measure.py) skips the refinement
 SPLIT_UNLESS = 0.8  # a candidate scoring this already: no split (0.1-0.3 ms a disc or piece refined)
@@ -107,23 +99,13 @@ SECOND_LOOK_UNLESS = 0.6  # nothing scoring this (the default acquisition thresh
 SECOND_LOOK_GAIN = 0.8  # ...with the V bound this much lower, grown (a ball's shaded side, a dim or backlit ball)...
 SECOND_LOOK_MIN = 0.75  # ...keeps what scores this: a fallback needs stronger evidence (tuning photos' empty views)
 RIM_LOOKS = 6  # blobs held down by their arcs or ring measured again with their rim, at most
-SMALL_RIM = 0.85  # a piece cut by edges under MIN_SIZE counts with this rim support (not texture)
 CIRCLE_BLOBS = 2  # the largest search blobs the circle look searches
-BLOB_PAD = 4  # px: a search blob's window for the edges and the circle look is this much wider on each side
 NEAR_GAIN = 0.4  # a tracked ball's closer look: the V bound this much lower (under the second look's reach)...
 NEAR_MARGIN = 0.1  # ...in a window this share of the frame's width wider than the ball on each side
 AIM_SPAN, AIM_SHARE = 0.35, 0.8  # the aim point's window (of the ball's diameter), and its share of target colour
 
 
-Box = tuple[int, int, int, int]  # x, y, width, height
-
-
-def _new(f: Features, found: list[Features]) -> bool:
-    """Not within a pixel of one already found (windows overlap; the splits find blobs the search found)."""
-    return all(abs(f.cx - g.cx) > 1.0 or abs(f.cy - g.cy) > 1.0 for g in found)
-
-
-class HsvBlobDetector(BlobMeasure):
+class HsvBlobDetector(WindowRefiner):
     name = "hsv"
 
     def __init__(
@@ -131,7 +113,6 @@ class HsvBlobDetector(BlobMeasure):
     ) -> None:
         super().__init__(config or HsvConfig(), vision or VisionConfig(), fov_deg)
         self._blobs: list[SearchBlob] = []  # the first look's search blobs, where the circle look searches
-        self._windows: dict[Box, tuple[Bounds, MatLike, MatLike, MatLike]] = {}  # this frame's blob windows
 
     @property
     def single_range(self) -> bool:
@@ -180,7 +161,7 @@ class HsvBlobDetector(BlobMeasure):
         """``found`` and what steps 1 and 2 find once more scoring ``SECOND_LOOK_MIN`` (a fallback look)."""
         self.keep_from = SECOND_LOOK_MIN
         more = self._look(image, bounds, small, small_hsv, scale, splits=False)
-        return found + [f for f in more if _new(f, found) and self.score(f, self._width) >= SECOND_LOOK_MIN]
+        return found + [f for f in more if is_new(f, found) and self.score(f, self._width) >= SECOND_LOOK_MIN]
 
     def _enough(self, found: list[Features], width: int) -> bool:
         """Whether a look found something the pilot would act on (no further look then)."""
@@ -194,7 +175,7 @@ class HsvBlobDetector(BlobMeasure):
             if max(bw, bh) * k < SIZE[1]:
                 continue
             x0, y0, roi, hsv, mask = self._blob_window(image, bounds, (x * k, y * k, bw * k, bh * k))
-            out += [f for f in circle_features(roi, hsv, mask, image, x0, y0, self.colour) if _new(f, found + out)]
+            out += [f for f in circle_features(roi, hsv, mask, image, x0, y0, self.colour) if is_new(f, found + out)]
         return out
 
     def _rim_look(self, found: list[Features]) -> list[Features]:
@@ -205,9 +186,9 @@ class HsvBlobDetector(BlobMeasure):
             f = self.measure(d.hsv, d.mask, d.contour, d.area, d.x0, d.y0, d.scale, bgr=d.bgr, rim=True)
             if f is None or (s := self.score(f, w)) < d.keep_from:
                 continue
-            same = [g for g in found if not _new(f, [g])]
+            same = [g for g in found if not is_new(f, [g])]
             if all(s > self.score(g, w) for g in same):
-                found = [g for g in found if _new(f, [g])] + [f]
+                found = [g for g in found if is_new(f, [g])] + [f]
         return found
 
     def _look(self, image: MatLike, bounds: Bounds, small: MatLike, small_hsv: MatLike, scale: int,
@@ -252,7 +233,7 @@ class HsvBlobDetector(BlobMeasure):
                 fs = [half]
             else:
                 fs = self._refine(image, bounds, (x * scale, y * scale, bw * scale, bh * scale))
-            found += [f for f in fs if _new(f, found)]
+            found += [f for f in fs if is_new(f, found)]
         good = not splits or any(self.score(f, w) >= SPLIT_UNLESS for f in found)
         if joined and not good:
             joined.sort(key=lambda b: b[0], reverse=True)
@@ -266,104 +247,6 @@ class HsvBlobDetector(BlobMeasure):
             blobs.sort(key=lambda b: b[0], reverse=True)
             found += self._edge_split(image, bounds, blobs, scale, found)
         return found
-
-    def _edge_split(self, image: MatLike, bounds: Bounds, blobs: list[SearchBlob],
-                    scale: int, found: list[Features]) -> list[Features]:
-        """Balls on a surface of their colour: the largest search blobs' windows cut by the image's edges, the
-        round pieces measured alone, their ring replaced by the share of their rim not walled in."""
-        out: list[Features] = []
-        for _, _, (x, y, bw, bh) in blobs[:EDGE_BLOBS]:
-            if max(bw, bh) * scale < MIN_SIZE:
-                continue
-            x0, y0, roi, hsv, mask = self._blob_window(image, bounds, (x * scale, y * scale, bw * scale, bh * scale))
-            cut = cut_by_edges(roi, mask, self.colour.kernel, self.cfg.min_area, SEARCH_FILL)
-            for c, area in cut.pieces:
-                piece = np.zeros_like(np.asarray(mask))
-                cv2.drawContours(piece, [c], -1, 255, -1)
-                f = self.measure(hsv, piece, c, area, x0, y0)
-                if f is None:
-                    continue
-                f = f._replace(size=f.size + WALL_GROWTH, ring=1.0 - walled_in(cut.separated, c))
-                if SIZE[1] <= f.size < MIN_SIZE:  # a small piece: a bit of texture unless a brightness edge all round
-                    f = f._replace(rim=rim_support(roi, f.cx - x0, f.cy - y0, (f.size - 1.0) / 2.0))
-                if (f.size >= MIN_SIZE or (f.size >= SIZE[1] and f.rim >= SMALL_RIM)) and _new(f, found + out):
-                    out.append(f)
-        return out
-
-    def _hue_split(self, image: MatLike, bounds: Bounds, hsv: MatLike, mask: MatLike,
-                   joined: list[SearchBlob], scale: int, found: list[Features]) -> list[Features]:
-        """Balls a few hue units off what they are joined to (a red ball on a red-brown saucer): the round pieces
-        of each hue class of the largest joined blobs (pilot/hsv_split.py), refined in that class's range (their
-        rings then see only their own hue). One range only (pilot/hsv_colour.py)."""
-        min_area = self.cfg.min_area / (scale * scale)
-        out: list[Features] = []
-        for sub, (px, py, pw, ph) in hue_pieces(hsv, mask, joined[:SPLIT_BLOBS], bounds, min_area, SEARCH_FILL,
-                                                self.colour.clean):
-            box = (px * scale, py * scale, pw * scale, ph * scale)
-            out += [f for f in self._refine(image, sub, box) if _new(f, found + out)]
-        return out
-
-    def _split(self, image: MatLike, bounds: Bounds, joined: list[SearchBlob],
-               scale: int, found: list[Features]) -> list[Features]:
-        """Balls joined to something of their colour: the widest discs of the largest joined blobs, refined."""
-        centres = sorted((p for _, c, box in joined[:SPLIT_BLOBS] for p in disc_centres(c, box)), reverse=True)
-        out: list[Features] = []
-        half = (scale - 1) / 2.0
-        for r, px, py in centres[:SPLIT_PEAKS]:
-            f = self._refine_disc(image, bounds, px * scale + half, py * scale + half, r * scale)
-            if f is not None and _new(f, found + out):
-                out.append(f)
-        return out
-
-    def _blob_window(self, image: MatLike, bounds: Bounds, box: Box) -> tuple[int, int, MatLike, MatLike, MatLike]:
-        """A search blob's window (``BLOB_PAD`` wider), its corner, pixels, HSV and mask; remembered for the frame:
-        the edges and the circle look search the same blobs with the same bounds."""
-        w, h = frame_size(image)
-        x, y, bw, bh = box
-        x0, y0 = max(0, x - BLOB_PAD), max(0, y - BLOB_PAD)
-        key = (x0, y0, min(w, x + bw + BLOB_PAD), min(h, y + bh + BLOB_PAD))
-        known = self._windows.get(key)
-        if known is None or known[0] is not bounds:
-            known = (bounds, *self._window(image, bounds, *key))
-            self._windows[key] = known
-        return x0, y0, known[1], known[2], known[3]
-
-    def _window(self, image: MatLike, bounds: Bounds, x0: int, y0: int, x1: int,
-                y1: int) -> tuple[MatLike, MatLike, MatLike]:
-        """The window's smoothed pixels, their HSV and the cleaned mask."""
-        # smoothed: sensor noise in a ball's shaded side would fray its outline and the shape with it
-        roi = cv2.medianBlur(np.ascontiguousarray(image[y0:y1, x0:x1]), 3)
-        hsv = cv2.cvtColor(roi, self.colour.code)
-        return roi, hsv, self.colour.clean(self.colour.in_range(hsv, bounds))
-
-    def _refine(self, image: MatLike, bounds: Bounds, box: Box) -> list[Features]:
-        """The blobs of a search box at full resolution (a search blob may be several joined by noise), in a
-        window that also holds their rings."""
-        w, h = frame_size(image)
-        bx, by, bw, bh = box
-        pad = max(bw, bh) // 2 + 4  # a ring reaches 1.75 radii; the search rounds by a pixel or two
-        x0, y0 = max(0, bx - pad), max(0, by - pad)
-        roi, hsv, mask = self._window(image, bounds, x0, y0, min(w, bx + bw + pad), min(h, by + bh + pad))
-        contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
-        blobs = [(a, c) for c in contours if len(c) >= 8 and (a := float(cv2.contourArea(c))) >= self.cfg.min_area]
-        blobs.sort(key=lambda b: b[0], reverse=True)
-        found = (self.measure(hsv, mask, c, area, x0, y0, bgr=roi) for area, c in blobs[:BLOBS_PER_BOX])
-        return [f for f in found if f is not None]
-
-    def _refine_disc(self, image: MatLike, bounds: Bounds, px: float, py: float, r: float) -> Features | None:
-        """The piece of the mask around a disc centre that an opening leaves (pilot/hsv_split.py), measured."""
-        w, h = frame_size(image)
-        pad = int(2.0 * r) + 6  # the ring reaches 1.75 radii
-        cx, cy = int(px), int(py)
-        x0, y0 = max(0, cx - pad), max(0, cy - pad)
-        _, hsv, mask = self._window(image, bounds, x0, y0, min(w, cx + pad + 1), min(h, cy + pad + 1))
-        piece = split_off(mask, cx - x0, cy - y0, r, self.cfg.min_area)
-        if piece is None:
-            return None
-        # the ring on the unopened mask: what the opening cut off is still around the ball
-        f = self.measure(hsv, mask, piece.contour, piece.area, x0, y0, cut=True)
-        # the widest disc gives the position and size (a drawn disc 2 R + 1 px across reads R at its centre)
-        return None if f is None else f._replace(cx=piece.cx + x0, cy=piece.cy + y0, size=2.0 * piece.radius + 1.0)
 
     def candidates(self, image: MatLike) -> list[Candidate]:
         return self._ranked(self.features(image), frame_size(image)[0])
