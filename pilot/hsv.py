@@ -168,7 +168,7 @@ class HsvBlobDetector(WindowRefiner):
         return small, bounds, cv2.cvtColor(small, self.colour.code)
 
     def _again(self, image: MatLike, bounds: Bounds, small: MatLike, small_hsv: MatLike, scale: int,
-               found: list[Features], splits: bool = False, same_frame: bool = False) -> list[Features]:
+               found: list[Features], splits: bool, same_frame: bool = False) -> list[Features]:
         """``found`` and what steps 1 and 2 (with ``splits``, 1 to 4) find once more scoring ``SECOND_LOOK_MIN`` (a
         fallback look); ``same_frame``: on the first look's frame, whose blobs it split or cut are not again."""
         self.keep_from = SECOND_LOOK_MIN

@@ -4,7 +4,6 @@ smoothed, and the laser's aim check read smoothed too (pilot/hsv_noise.py, pilot
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import cv2
 import numpy as np
@@ -99,29 +98,3 @@ def test_real_photos_in_a_dark_room_at_full_gain(monkeypatch: pytest.MonkeyPatch
     recall_without, _ = rates()
     assert recall >= 0.75 and empty == 0.0
     assert recall >= recall_without + 0.03  # 150 views: 4.6 points here, 12 on bench/vision's 400
-
-
-def test_the_smoothed_look_splits_a_ball_joined_to_something_of_its_colour(monkeypatch: pytest.MonkeyPatch) -> None:
-    """bench/vision's noise condition (8-12 per channel) on the tuning photos: a ball joined in the mask to a red
-    surface is split off in the smoothed look as in the first one. Without the splits there, fewer balls (3 and 6 of
-    400 on two seeds); the empty views as quiet either way."""
-    views = ve.samples(vi.TUNING, 29, 400, 0, 0, "ball", (16.0, 120.0), ("noise",))
-    rng = np.random.default_rng(30)
-    views += [vi.empty_sample(rng, vi.TUNING, "noise") for _ in range(100)]
-
-    def counts() -> tuple[int, int]:
-        records = ve.run(HsvBlobDetector().candidates, views)
-        found = sum(1 for r in records if r.kind == "target" and ve.correct(r, 0.6))
-        return found, sum(1 for r in records if r.kind == "empty" and ve.detected(r, 0.6))
-
-    found, empty = counts()
-    again = HsvBlobDetector._again
-
-    def without(self: HsvBlobDetector, image: Any, bounds: Any, small: Any, small_hsv: Any, scale: int, found: Any,
-                splits: bool = False, same_frame: bool = False) -> Any:  # the smoothed look is on another frame
-        return again(self, image, bounds, small, small_hsv, scale, found, splits and same_frame, same_frame)
-
-    monkeypatch.setattr(HsvBlobDetector, "_again", without)
-    found_without, empty_without = counts()
-    assert found >= found_without + 4 and found >= 0.88 * 400
-    assert empty == empty_without == 0
