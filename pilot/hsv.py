@@ -65,9 +65,14 @@ of ``hsv_refine.SMALL_RIM``.
 
 A frame where still nothing scores ``SECOND_LOOK_UNLESS`` gets a circle look (pilot/hsv_circles.py): in the first
 look's ``CIRCLE_BLOBS`` largest blobs' windows, circles of brightness edges (the best of each octave of radii) with
-the target's colour inside (one circle to a window: several are a texture of round things, a flower's petals). A
+the target's colour inside (one circle to a window: several are a texture of round things, a flower's petals; none
+under ``hsv_circles.MIN_SIZE`` across, as often a texture's hollow as a ball). A
 ball on a textured surface of its colour, which even the edges cut into pieces (its shading is an edge inside it),
 is one blob with that surface; only its rim tells it apart. It costs about 1 ms a window, in frames with no ball.
+
+Every look keeps only the blobs from ``hsv_inside.FROM`` px across that are plain inside (pilot/hsv_inside.py): a
+round texture of the target's colour (a dahlia's heart, its red cups merged by JPEG's blocks) is brightness edges
+all over inside, a ball is not.
 
 A tracked ball the frame's look misses gets a closer look where the track expects it (``candidates_near``, called
 by pilot/detect.py): that window refined with the V bound ``NEAR_GAIN`` times as high.
@@ -87,6 +92,7 @@ from .config import HsvConfig, VisionConfig
 from .detection import Candidate, Detection, best_detection, frame_size
 from .hsv_circles import circle_features
 from .hsv_colour import Bounds, darker, grown
+from .hsv_inside import busy_inside
 from .hsv_measure import HALF_DECIDES
 from .hsv_noise import smoothed
 from .hsv_refine import EDGE_BLOBS, SEARCH_FILL, SPLIT_BLOBS, Box, WindowRefiner, is_new
@@ -124,6 +130,7 @@ class HsvBlobDetector(WindowRefiner):
         super().__init__(config or HsvConfig(), vision or VisionConfig(), fov_deg)
         self._blobs: list[SearchBlob] = []  # the first look's search blobs, where the circle look searches
         self._tried: set[tuple[float, Box]] = set()  # the first look's blobs split or cut by edges (area, box)
+        self._plain_ok: dict[int, Features] = {}  # this frame's blobs found plain inside (by id, kept alive)
 
     @property
     def single_range(self) -> bool:
@@ -141,24 +148,39 @@ class HsvBlobDetector(WindowRefiner):
         w = frame_size(image)[0]
         self.new_frame(w)
         self._windows.clear()
+        self._plain_ok.clear()
         scale = 2 if w >= SEARCH_MIN_WIDTH else 1
         small, bounds, small_hsv = self._search(image, scale)
-        found = self._look(image, bounds, small, small_hsv, scale)
+        found = self._plain(image, self._look(image, bounds, small, small_hsv, scale))
         if self._enough(found, w):
             return found
         if (lower := grown(bounds, SECOND_LOOK_GAIN)) is not None:  # not at the floor
-            found = self._again(image, lower, small, small_hsv, scale, found, splits=True, same_frame=True)
+            found = self._plain(image, self._again(image, lower, small, small_hsv, scale, found, splits=True,
+                                                   same_frame=True))
             if self._enough(found, w):
                 return found
         if (smooth := smoothed(image)) is not None:  # a noisy frame (pilot/hsv_noise.py)
             s_small, s_bounds, s_hsv = self._search(smooth, scale)
-            found = self._again(smooth, s_bounds, s_small, s_hsv, scale, found, splits=True)
+            found = self._plain(image, self._again(smooth, s_bounds, s_small, s_hsv, scale, found, splits=True))
             if self._enough(found, w):
                 return found
-        found = self._rim_look(found)
+        found = self._plain(image, self._rim_look(found))
         if self._enough(found, w):
             return found
-        return found + self._circle_look(image, bounds, found)
+        return found + self._plain(image, self._circle_look(image, bounds, found))
+
+    def _plain(self, image: MatLike, found: list[Features]) -> list[Features]:
+        """``found`` without the blobs a candidate could come of that are brightness edges inside: a texture of the
+        target's colour, not a ball (pilot/hsv_inside.py; checked once each)."""
+        w = self._width
+        out = []
+        for f in found:
+            if id(f) not in self._plain_ok:
+                if self.score(f, w) >= self.cfg.min_score and busy_inside(image, f.cx, f.cy, f.size):
+                    continue
+                self._plain_ok[id(f)] = f
+            out.append(f)
+        return out
 
     def _search(self, image: MatLike, scale: int) -> tuple[MatLike, Bounds, MatLike]:
         """The search's frame (``scale`` times smaller), its bounds for the frame's exposure, and its HSV."""
@@ -291,7 +313,7 @@ class HsvBlobDetector(WindowRefiner):
         if x1 - x0 < 2 or y1 - y0 < 2:
             return []
         found = self._refine(image, darker(self.colour.bounds_for(image), NEAR_GAIN), (x0, y0, x1 - x0, y1 - y0))
-        return self._ranked(found, w)
+        return self._ranked(self._plain(image, found), w)
 
     def detect(self, image: MatLike) -> Detection:
         """This frame alone, the best candidate (no tracking, no frame checks)."""
