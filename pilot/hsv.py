@@ -65,8 +65,7 @@ of ``hsv_refine.SMALL_RIM``.
 
 A frame where still nothing scores ``SECOND_LOOK_UNLESS`` gets a circle look (pilot/hsv_circles.py): in the first
 look's ``CIRCLE_BLOBS`` largest blobs' windows, circles of brightness edges (the best of each octave of radii) with
-the target's colour inside (one circle to a window: several are a texture of round things, a flower's petals; none
-under ``hsv_circles.MIN_SIZE`` across, as often a texture's hollow as a ball). A
+the target's colour inside (one circle to a window: several are a texture of round things, a flower's petals). A
 ball on a textured surface of its colour, which even the edges cut into pieces (its shading is an edge inside it),
 is one blob with that surface; only its rim tells it apart. It costs about 1 ms a window, in frames with no ball.
 

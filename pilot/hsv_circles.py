@@ -21,7 +21,7 @@ from cv2.typing import MatLike
 
 from .hsv_colour import ColourMask
 from .hsv_rim import best_rim
-from .hsv_score import SIZE, Features
+from .hsv_score import Features
 from .hsv_shape import unit_circle
 
 CANNY = (60, 150)  # hysteresis thresholds on the grey image (pilot/hsv_edges.py's, on each channel there)
@@ -38,9 +38,6 @@ INSIDE = 0.95  # the share of points inside the circle (to 0.8 radii) in the mas
 # dahlia's petals passed: on the validation photos' dev seeds, 115 of 2,400 empty views with a detection, 61 at 0.95;
 # 3 balls fewer of 3,400 on the tuning photos' (bench/vision/vision_imagery.py)
 RIM_MIN = 0.8  # rim support below this is no ball (the score's RIM ramp then decides)
-MIN_SIZE = SIZE[1]  # px across: a smaller circle, with no outline in the mask to back its rim, is a hollow of a
-# texture as often as a ball (the red cups at a dahlia's heart; on the validation photos' dev seeds, 7 of 1,000 empty
-# views and 2 of 500 distractor views with a detection came of one, for 6 balls of 4,800 on the three dev seed sets)
 
 _NEAR = np.ones((5, 5), np.uint8)  # edges this close to the mask vote (a rim lies just outside the blob's mask)
 _PEAK = np.ones((3, 3), np.uint8)
@@ -183,8 +180,6 @@ def circle_features(roi: MatLike, hsv: MatLike, mask: MatLike, frame: MatLike, x
     if _objects(found) > 1:
         return []
     for c in found:
-        if 2.0 * c.r < MIN_SIZE:
-            continue
         disc = np.zeros(mask.shape[:2], np.uint8)
         cv2.circle(disc, (round(c.cx), round(c.cy)), max(1, int(0.9 * c.r)), 255, -1)
         mean = cv2.mean(hsv, mask=cv2.bitwise_and(disc, mask))

@@ -36,7 +36,7 @@ def on_surface(r: float, seed: int, texture: float, centres: tuple[tuple[float, 
     return np.asarray(np.clip(img, 0, 255), np.uint8)
 
 
-@pytest.mark.parametrize("r,seed,texture", [(11, 0, 40), (11, 1, 40), (12, 0, 40), (12, 1, 40)])
+@pytest.mark.parametrize("r,seed,texture", [(9, 0, 20), (9, 1, 40), (12, 0, 40), (12, 1, 40)])
 def test_a_ball_on_a_surface_of_its_colour_is_found_by_the_circle_look_only(
         r: float, seed: int, texture: float, monkeypatch: pytest.MonkeyPatch) -> None:
     img = on_surface(r, seed, texture)
