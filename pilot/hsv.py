@@ -69,9 +69,8 @@ the target's colour inside (one circle to a window: several are a texture of rou
 ball on a textured surface of its colour, which even the edges cut into pieces (its shading is an edge inside it),
 is one blob with that surface; only its rim tells it apart. It costs about 1 ms a window, in frames with no ball.
 
-Every look keeps only the blobs from ``hsv_inside.FROM`` px across that are plain inside (pilot/hsv_inside.py): a
-round texture of the target's colour (a dahlia's heart, its red cups merged by JPEG's blocks) is brightness edges
-all over inside, a ball is not.
+Every look drops the blobs from ``hsv_inside.FROM`` px across that are brightness edges inside (pilot/hsv_inside.py):
+a round texture of the target's colour (a dahlia's heart, its red cups merged by JPEG's blocks), not a plain ball.
 
 A tracked ball the frame's look misses gets a closer look where the track expects it (``candidates_near``, called
 by pilot/detect.py): that window refined with the V bound ``NEAR_GAIN`` times as high.
