@@ -4,11 +4,19 @@ tests share the build folders of the repo (firmware/build, build/tests, build/ta
 
 from __future__ import annotations
 
+import signal
 from pathlib import Path
 
 import pytest
 
 TESTS = Path(__file__).resolve().parent
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    # a shell starts a background job (`make test &`, nohup) with SIGINT ignored, and every child inherits that; the
+    # pilot's tests deliver SIGINT to it, in the worker itself and to the pilot's own processes, and would wait in vain
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which reads the groups
