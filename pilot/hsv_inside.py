@@ -18,11 +18,12 @@ import cv2
 import numpy as np
 from cv2.typing import MatLike
 
+from .hsv_circles import CANNY  # the circle look's thresholds on the grey image: the same edges
+
 FROM = 40.0  # px across: the hearts that fired were 54-60 px; only blobs this large pay for the check (0.02-0.1 ms)
 EDGES_MAX = 0.2  # the share of the inside (to 0.7 radii) that may be a brightness edge
 INSIDE = 0.7  # radii: the inside read (the rim's own edge blurs inwards)
 SIGMA = 1.0  # px, the smoothing's Gaussian
-CANNY = (60, 150)  # hysteresis thresholds on the grey image (pilot/hsv_circles.py's)
 
 
 def busy_inside(image: MatLike, cx: float, cy: float, size: float) -> bool:
