@@ -35,10 +35,10 @@ def share_set(mask: MatLike, cx: float, cy: float, unit: npt.NDArray[np.float64]
     h, w = mask.shape[:2]
     reach = 1.7 * r + 1.0
     if reach <= cx < w - reach and reach <= cy < h - reach:  # all inside: the usual case, read by flat index
-        xs, ys = unit.T  # + 0.5: truncation rounds
-        flat = (ys * r + (cy + 0.5)).astype(np.intp) * w + (xs * r + (cx + 0.5)).astype(np.intp)
+        xs, ys = unit.T
+        flat = (ys * r + (cy + 0.5)).astype(np.intp) * w + (xs * r + (cx + 0.5)).astype(np.intp)  # + 0.5: rounds
         return float(np.count_nonzero(np.asarray(mask).ravel().take(flat))) / len(flat)
-    pos = unit * r + (cx + 0.5, cy + 0.5)
+    pos = unit * r + (cx + 0.5, cy + 0.5)  # + 0.5: truncation rounds
     idx = pos[(pos[:, 0] >= 0.0) & (pos[:, 0] < w) & (pos[:, 1] >= 0.0) & (pos[:, 1] < h)].astype(np.intp)
     if not len(idx):
         return 1.0
