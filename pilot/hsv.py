@@ -58,10 +58,10 @@ condition, 4-7 balls fewer of about 165 per photo set, with the same false detec
 such a frame's centre smoothed too.
 
 A frame where nothing scores ``SECOND_LOOK_UNLESS`` after these looks gets a rim look (pilot/hsv_measure.py): the
-blobs that their arcs or ring held down are measured again with their rim support (pilot/hsv_rim.py), a brightness
-edge all round them, which stands in for the arcs (a mask frayed by JPEG's colour blocks, noise or shade) and for
-isolation (a ball on a surface of its colour). Pieces cut by edges under ``hsv_edges.MIN_SIZE`` count with a rim
-of ``hsv_refine.SMALL_RIM``.
+blobs that their arcs or ring held down are measured again with their rim support (pilot/hsv_rim.py), an edge all
+round them in brightness (or, short of that, in a colour channel), which stands in for the arcs (a mask frayed by
+JPEG's colour blocks, noise or shade) and for isolation (a ball on a surface of its colour). Pieces cut by edges
+under ``hsv_edges.MIN_SIZE`` count with a brightness rim of ``hsv_refine.SMALL_RIM``.
 
 A frame where still nothing scores ``SECOND_LOOK_UNLESS`` gets a circle look (pilot/hsv_circles.py): in the first
 look's ``CIRCLE_BLOBS`` largest blobs' windows, circles of brightness edges (the best of each octave of radii) with

@@ -6,7 +6,7 @@ cut it into pieces too: its shading (the terminator, the highlight) is an edge i
 rim is still a circle of brightness edges whose gradients point along the radius. Here the window's edge pixels
 near the mask vote, along their gradient both ways, for the centre of a circle of each radius they might lie on
 (a Hough transform for circles); the best centres of each octave of radii are checked for the target's colour
-inside, and for rim support (pilot/hsv_rim.py), which also refines the circle.
+inside, and for rim support (pilot/hsv_rim.py, in brightness or in colour), which also refines the circle.
 """
 
 from __future__ import annotations
@@ -20,11 +20,11 @@ import numpy.typing as npt
 from cv2.typing import MatLike
 
 from .hsv_colour import ColourMask
-from .hsv_rim import best_rim
+from .hsv_inside import CANNY
+from .hsv_rim import WHOLE, best_rim
 from .hsv_score import Features
 from .hsv_shape import unit_circle
 
-CANNY = (60, 150)  # hysteresis thresholds on the grey image (pilot/hsv_edges.py's, on each channel there)
 RADII = np.exp(np.arange(math.log(7.5), math.log(62.0), 0.15)).astype(np.float32)  # 15 % apart: 16-120 px balls
 CELL = 2  # px: the centre votes' grid
 EDGES_MAX = 800  # edge pixels voting at most (evenly thinned): the cost stays bounded in a textured window
@@ -37,7 +37,6 @@ PER_BAND = 2  # ...and the best centres of each checked per window. Ranked toget
 INSIDE = 0.95  # the share of points inside the circle (to 0.8 radii) in the mask. At 0.85, the dark hollows of a
 # dahlia's petals passed: on the validation photos' dev seeds, 115 of 2,400 empty views with a detection, 61 at 0.95;
 # 3 balls fewer of 3,400 on the tuning photos' (bench/vision/vision_imagery.py)
-RIM_MIN = 0.8  # rim support below this is no ball (the score's RIM ramp then decides)
 
 _NEAR = np.ones((5, 5), np.uint8)  # edges this close to the mask vote (a rim lies just outside the blob's mask)
 _PEAK = np.ones((3, 3), np.uint8)
@@ -151,8 +150,8 @@ def circles(roi: MatLike, mask: MatLike, frame: MatLike, x0: int, y0: int) -> li
         inside = inside_share(mask, cx, cy, r)
         if inside < INSIDE:
             continue
-        rim, bx, by, br = best_rim(frame, cx + x0, cy + y0, r)
-        if rim >= RIM_MIN:  # two centres may fit the same rim: the detector keeps the first (hsv._new)
+        rim, bx, by, br = best_rim(frame, cx + x0, cy + y0, r, colour=True)
+        if rim >= WHOLE:  # two centres may fit the same rim: the detector keeps the first (hsv._new)
             out.append(Circle(bx - x0, by - y0, br, inside, rim))
     return out
 

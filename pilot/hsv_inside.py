@@ -18,8 +18,8 @@ import cv2
 import numpy as np
 from cv2.typing import MatLike
 
-from .hsv_circles import CANNY  # the circle look's thresholds on the grey image: the same edges
-
+CANNY = (60, 150)  # hysteresis thresholds on the grey image (the circle look's too; pilot/hsv_edges.py's, on each
+# channel there)
 FROM = 40.0  # px across: the hearts that fired were 54-60 px; only blobs this large pay for the check (0.02-0.1 ms)
 EDGES_MAX = 0.2  # the share of the inside (to 0.7 radii) that may be a brightness edge
 INSIDE = 0.7  # radii: the inside read (the rim's own edge blurs inwards)

@@ -9,6 +9,16 @@ circle, and a red surface's texture is an edge here and there, not all the way r
 The circle is looked for near the one given, a blob's enclosing circle or one the circle look (pilot/hsv_circles.py)
 voted for (``SCALES`` x ``SHIFTS``: a frayed mask or a coarse vote moves and sizes it a little), all circles sampled
 in one pass.
+
+A ball on a surface of its own colour may differ from it more in one channel than in brightness (a crimson ball on
+an orange-red saucer: the green and blue channels step, the grey level barely). Where the brightness rim falls short
+of ``WHOLE``, a circle from ``COLOUR_FROM`` px across is measured again with the edges of each colour channel, and
+counts from ``COLOUR_MIN`` round an inside with no more brightness edges than a plain ball's (pilot/hsv_inside.py,
+at any size). On the dev seeds of bench/vision's tuning photos (not the report's), the true circle of the
+117 balls that had no candidate near them had a brightness rim of 0.8 or more for 23 of them, a colour one for 87.
+What else had a colour rim was a red lamp with a yellow glow inside (the tuning photos' motorbike, 17-24 px): the
+inside check, which only balls from 40 px pay for otherwise, read 0.20-0.27 there, at most 0.18 on the balls the
+colour rim found.
 """
 
 from __future__ import annotations
@@ -18,6 +28,7 @@ import numpy as np
 import numpy.typing as npt
 from cv2.typing import MatLike
 
+from .hsv_inside import EDGES_MAX, inside_edges
 from .hsv_shape import unit_circle
 
 EDGE = 40.0  # Sobel (3x3) response across the rim, about a 10-level step in brightness: sensor noise is below it
@@ -32,6 +43,13 @@ HALF_FROM = 16.0  # px (radius): a circle this wide is measured at half resoluti
 # in 4,800 empty and distractor views and in 2,400 of the validation photos' (from a radius of 12: JPEG 86.1 %, 2
 # validation empty views more; from 20: 85.1 %)
 
+WHOLE = 0.8  # a brightness rim this whole is a ball's (the circle look's bar; the score's RIM ramp reaches 1 above)
+COLOUR_MIN = 0.88  # of the points (43 of 48), on a colour channel's edges: more are edges there than in brightness
+# (texture, print); at 0.8 and 0.84, 6 and 3 more of 4,500 empty and distractor views on the three dev seed sets
+# had a detection, at 0.88 none, nor at 0.9 (with 6 balls fewer)
+COLOUR_FROM = 18.0  # px across: a smaller circle is measured in brightness only. A red lamp 15-17 px across on the
+# tuning photos' motorbike, a red ring round a yellow glow, has a colour rim all round
+
 _U = unit_circle(48)
 _FACTORS = np.array([k for k in SCALES for _ in SHIFTS for _ in SHIFTS])[:, None, None]
 _OFFSETS = np.array([(dx, dy) for _ in SCALES for dx in SHIFTS for dy in SHIFTS])[:, None, :]
@@ -39,17 +57,29 @@ _UNIT = _FACTORS * _U[None, :, :] + _OFFSETS  # circles x points x (x, y), in ra
 _REACH = max(SCALES) + max(SHIFTS) * 1.5  # the farthest a point lies from the centre, in radii (with margin)
 
 
-def rim_support(bgr: MatLike, cx: float, cy: float, r: float) -> float:
+def rim_support(bgr: MatLike, cx: float, cy: float, r: float, colour: bool = False) -> float:
     """The best share, over the circles tried near (cx, cy, r) in ``bgr``'s pixels, of a circle's 48 points
     where the brightness's gradient is at least ``EDGE`` and points along the radius (either way: a ball's lit
-    side may be brighter than what lies behind it, its shaded side darker)."""
-    counts = _counts(bgr, cx, cy, r)
-    return 0.0 if counts is None else float(counts.max()) / len(_U)
+    side may be brighter than what lies behind it, its shaded side darker); ``colour``: see ``best_rim``."""
+    return best_rim(bgr, cx, cy, r, colour)[0]
 
 
-def best_rim(bgr: MatLike, cx: float, cy: float, r: float) -> tuple[float, float, float, float]:
-    """``rim_support`` and the circle that has it (centre, radius)."""
-    counts = _counts(bgr, cx, cy, r)
+def best_rim(bgr: MatLike, cx: float, cy: float, r: float,
+             colour: bool = False) -> tuple[float, float, float, float]:
+    """``rim_support`` and the circle that has it (centre, radius). ``colour``: a rim short of ``WHOLE`` in
+    brightness, from ``COLOUR_FROM`` px across, is measured in each colour channel too; that one counts if it
+    reaches ``COLOUR_MIN`` and the circle is plain inside."""
+    rim = _best(bgr, cx, cy, r, False)
+    if colour and rim[0] < WHOLE and 2.0 * r >= COLOUR_FROM:
+        in_colour = _best(bgr, cx, cy, r, True)
+        _, bx, by, br = in_colour
+        if in_colour[0] >= COLOUR_MIN and inside_edges(bgr, bx, by, 2.0 * br) <= EDGES_MAX:
+            return in_colour
+    return rim
+
+
+def _best(bgr: MatLike, cx: float, cy: float, r: float, colour: bool) -> tuple[float, float, float, float]:
+    counts = _counts(bgr, cx, cy, r, colour)
     if counts is None:
         return 0.0, cx, cy, r
     top = counts == counts.max()
@@ -61,8 +91,9 @@ def best_rim(bgr: MatLike, cx: float, cy: float, r: float) -> tuple[float, float
     return float(counts.max()) / len(_U), float(cx + dx * r), float(cy + dy * r), widest * r
 
 
-def _counts(bgr: MatLike, cx: float, cy: float, r: float) -> npt.NDArray[np.intp] | None:
-    """For each circle tried, how many of its points are on the rim; None where the window is too small."""
+def _counts(bgr: MatLike, cx: float, cy: float, r: float, colour: bool) -> npt.NDArray[np.intp] | None:
+    """For each circle tried, how many of its points are on the rim (``colour``: on an edge of any channel);
+    None where the window is too small."""
     h, w = bgr.shape[:2]
     k = 2 if r >= HALF_FROM else 1
     reach = _REACH * r + 2.0 * k
@@ -71,20 +102,23 @@ def _counts(bgr: MatLike, cx: float, cy: float, r: float) -> npt.NDArray[np.intp
     x1, y1 = x0 + (x1 - x0) // k * k, y0 + (y1 - y0) // k * k
     if x1 - x0 < 3 * k or y1 - y0 < 3 * k:
         return None
-    grey = cv2.cvtColor(np.ascontiguousarray(bgr[y0:y1, x0:x1]), cv2.COLOR_BGR2GRAY)
+    roi = np.ascontiguousarray(bgr[y0:y1, x0:x1])
+    img = roi if colour else cv2.cvtColor(roi, cv2.COLOR_BGR2GRAY)
     if k > 1:
-        grey = cv2.resize(grey, ((x1 - x0) // k, (y1 - y0) // k), interpolation=cv2.INTER_AREA)
-    gh, gw = grey.shape[:2]
-    gx = cv2.Sobel(grey, cv2.CV_32F, 1, 0, ksize=3)
-    gy = cv2.Sobel(grey, cv2.CV_32F, 0, 1, ksize=3)
+        img = cv2.resize(img, ((x1 - x0) // k, (y1 - y0) // k), interpolation=cv2.INTER_AREA)
+    gh, gw = img.shape[:2]
+    gx = cv2.Sobel(img, cv2.CV_32F, 1, 0, ksize=3)
+    gy = cv2.Sobel(img, cv2.CV_32F, 0, 1, ksize=3)
+    if not colour:  # one channel: the same arithmetic as three (a trailing axis of one)
+        gx, gy = gx[..., None], gy[..., None]
     # a pixel's centre at i lies at (i + 0.5) / k - 0.5 in the window; + 0.5 again: truncation rounds
     pos = _UNIT * (r / k) + ((cx - x0 + 0.5) / k, (cy - y0 + 0.5) / k)
     ix, iy = pos[..., 0].astype(np.intp), pos[..., 1].astype(np.intp)
     # the Sobel's outer row and column see the border, not the image: points there count as no edge
     inside = (ix >= 1) & (ix < gw - 1) & (iy >= 1) & (iy < gh - 1)
     ix, iy = np.where(inside, ix, 1), np.where(inside, iy, 1)
-    vx, vy = gx[iy, ix], gy[iy, ix]
-    across: npt.NDArray[np.float64] = vx * _U[:, 0] + vy * _U[:, 1]  # the circle's normal is its unit point
+    vx, vy = gx[iy, ix], gy[iy, ix]  # circles x points x channels
+    across: npt.NDArray[np.float64] = vx * _U[:, :1] + vy * _U[:, 1:]  # the circle's normal is its unit point
     sq = across * across
-    good = inside & (sq >= EDGE * EDGE) & (sq >= RADIAL * (vx * vx + vy * vy))
-    return np.asarray(np.count_nonzero(good, axis=1), np.intp)
+    edge = ((sq >= EDGE * EDGE) & (sq >= RADIAL * (vx * vx + vy * vy))).any(axis=2)
+    return np.asarray(np.count_nonzero(inside & edge, axis=1), np.intp)

@@ -62,9 +62,9 @@ def test_a_frayed_ball_is_found_by_its_rim_and_only_by_it(r: int, band: int, blo
 def test_a_plain_ball_never_pays_for_a_rim(monkeypatch: pytest.MonkeyPatch) -> None:
     calls: list[float] = []
 
-    def counted(bgr: Image, cx: float, cy: float, r: float) -> float:
+    def counted(bgr: Image, cx: float, cy: float, r: float, colour: bool = False) -> float:
         calls.append(r)
-        return rim_support(bgr, cx, cy, r)
+        return rim_support(bgr, cx, cy, r, colour)
 
     monkeypatch.setattr(hsv_measure, "rim_support", counted)
     img = np.full((240, 320, 3), WALL, np.uint8)
