@@ -45,8 +45,8 @@ HALF_FROM = 16.0  # px (radius): a circle this wide is measured at half resoluti
 
 WHOLE = 0.8  # a brightness rim this whole is a ball's (the circle look's bar; the score's RIM ramp reaches 1 above)
 COLOUR_MIN = 0.88  # of the points (43 of 48), on a colour channel's edges: more are edges there than in brightness
-# (texture, print); at 0.8 and 0.84, 6 and 3 more of 4,500 empty and distractor views on the three dev seed sets
-# had a detection, at 0.88 none, nor at 0.9 (with 6 balls fewer)
+# (texture, print); at 0.8 and 0.84, 9 and 3 more of 4,500 empty and distractor views on the three dev seed sets
+# had a detection, at 0.88 none, nor at 0.9 (with 7 balls fewer)
 COLOUR_FROM = 18.0  # px across: a smaller circle is measured in brightness only. A red lamp 15-17 px across on the
 # tuning photos' motorbike, a red ring round a yellow glow, has a colour rim all round
 
