@@ -49,9 +49,8 @@ def test_the_second_look_splits_the_blobs_its_grown_mask_joined(monkeypatch: pyt
 
 def test_the_smoothed_look_splits_a_ball_joined_to_something_of_its_colour(monkeypatch: pytest.MonkeyPatch) -> None:
     """bench/vision's noise condition (8-12 per channel): a ball joined in the mask to a red surface is split off in
-    the smoothed look as in the first one. Without the splits there, fewer balls (6 of 400 on this seed; 3 and 6 on
-    seeds 29 and 37, where the colour rim of the rim and circle looks, pilot/hsv_rim.py, finds some of them too);
-    the empty views as quiet either way (one of 100 here, and on seed 29, with the splits or without)."""
+    the smoothed look as in the first one. Without the splits there, fewer balls (8 of 400 on this seed; 4 and 7 on
+    seeds 29 and 37); the empty views as quiet either way (one of 100 here, with the splits or without)."""
     views = ve.samples(vi.TUNING, 33, 400, 0, 0, "ball", (16.0, 120.0), ("noise",))
     rng = np.random.default_rng(34)
     views += [vi.empty_sample(rng, vi.TUNING, "noise") for _ in range(100)]
