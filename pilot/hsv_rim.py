@@ -64,7 +64,10 @@ def rim_support(bgr: MatLike, cx: float, cy: float, r: float, colour: bool = Fal
     """The best share, over the circles tried near (cx, cy, r) in ``bgr``'s pixels, of a circle's 48 points
     where the brightness's gradient is at least ``EDGE`` and points along the radius (either way: a ball's lit
     side may be brighter than what lies behind it, its shaded side darker); ``colour``: see ``best_rim``."""
-    return best_rim(bgr, cx, cy, r, colour)[0]
+    if colour:  # the colour rim's inside check needs the best circle itself
+        return best_rim(bgr, cx, cy, r, True)[0]
+    counts = _counts(bgr, cx, cy, r, False)
+    return 0.0 if counts is None else float(counts.max()) / len(_U)
 
 
 def best_rim(bgr: MatLike, cx: float, cy: float, r: float,
