@@ -75,6 +75,13 @@ def detected(r: Record, threshold: float) -> bool:
     return r.found and r.confidence >= threshold
 
 
+def counts(candidates: Candidates, views: list[vi.Sample], threshold: float) -> tuple[int, int]:
+    """The target views with a correct detection, and the empty views with any (an A/B of one detector change)."""
+    records = run(candidates, views)
+    return (sum(r.kind == "target" and correct(r, threshold) for r in records),
+            sum(r.kind == "empty" and detected(r, threshold) for r in records))
+
+
 @dataclass(frozen=True)
 class Row:
     group: str

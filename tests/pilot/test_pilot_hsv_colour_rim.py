@@ -61,13 +61,6 @@ def test_a_busy_inside_takes_no_colour_rim(r: int, monkeypatch: pytest.MonkeyPat
     assert rim_support(img, CX, CY, r, colour=True) >= COLOUR_MIN
 
 
-def counts(views: list[vi.Sample]) -> tuple[int, int]:
-    """Balls from 16 px found at the acquisition threshold, and empty views with a detection."""
-    records = ve.run(HsvBlobDetector().candidates, views)
-    balls = sum(1 for r in records if r.kind == "target" and r.size >= 16 and ve.correct(r, THRESHOLD))
-    return balls, sum(1 for r in records if r.kind == "empty" and ve.detected(r, THRESHOLD))
-
-
 @pytest.mark.parametrize("seed", [61, 65])
 def test_jpeg_views_give_more_balls_and_no_more_detections_in_empty_views(seed: int,
                                                                          monkeypatch: pytest.MonkeyPatch) -> None:
@@ -76,8 +69,8 @@ def test_jpeg_views_give_more_balls_and_no_more_detections_in_empty_views(seed: 
     views = ve.samples(vi.TUNING, seed, 300, 0, 0, "ball", (16.0, 120.0), ("jpeg",))
     rng = np.random.default_rng(seed + 1)
     views += [vi.empty_sample(rng, vi.TUNING, "jpeg") for _ in range(200)]
-    balls, empty = counts(views)
+    balls, empty = ve.counts(HsvBlobDetector().candidates, views, THRESHOLD)
     monkeypatch.setattr(hsv_rim, "COLOUR_MIN", 1.1)  # no colour rim counts
-    balls_without, empty_without = counts(views)
+    balls_without, empty_without = ve.counts(HsvBlobDetector().candidates, views, THRESHOLD)
     assert balls >= balls_without + 3
     assert empty == empty_without

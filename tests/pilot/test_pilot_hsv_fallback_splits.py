@@ -16,9 +16,7 @@ from pilot.hsv import HsvBlobDetector
 
 def counts(views: list[vi.Sample]) -> tuple[int, int]:
     """Balls found at the acquisition threshold, and empty views with a detection."""
-    records = ve.run(HsvBlobDetector().candidates, views)
-    found = sum(1 for r in records if r.kind == "target" and ve.correct(r, 0.6))
-    return found, sum(1 for r in records if r.kind == "empty" and ve.detected(r, 0.6))
+    return ve.counts(HsvBlobDetector().candidates, views, 0.6)
 
 
 def without_splits(monkeypatch: pytest.MonkeyPatch, in_same_frame: bool) -> None:
