@@ -116,8 +116,8 @@ class ColourMask:
         k = max(1, grid.size // 50)  # the 98th percentile, without a sort
         if np.count_nonzero(grid >= V_REFERENCE) >= k:  # at least the reference: the configured bound (most frames)
             return self.ranges
-        gain = float(np.partition(grid, grid.size - k)[grid.size - k]) / V_REFERENCE
-        return darker(self.ranges, gain)
+        grid.partition(grid.size - k)  # in place: the grid is a copy
+        return darker(self.ranges, float(grid[grid.size - k]) / V_REFERENCE)
 
     def _grid(self, image: MatLike) -> npt.NDArray[np.uint8]:
         """Every channel of the pixels on a grid of about 24x18 at any frame size, one flat array. Taken by flat

@@ -108,7 +108,7 @@ class WindowRefiner(BlobMeasure):
                 y1: int) -> tuple[MatLike, MatLike, MatLike]:
         """The window's smoothed pixels, their HSV and the cleaned mask."""
         # smoothed: sensor noise in a ball's shaded side would fray its outline and the shape with it
-        roi = cv2.medianBlur(np.ascontiguousarray(image[y0:y1, x0:x1]), 3)
+        roi = cv2.medianBlur(image[y0:y1, x0:x1], 3)  # a view: OpenCV reads its rows in place
         hsv = cv2.cvtColor(roi, self.colour.code)
         return roi, hsv, self.colour.clean(self.colour.in_range(hsv, bounds))
 
