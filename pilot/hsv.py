@@ -84,6 +84,7 @@ from __future__ import annotations
 import math
 
 import cv2
+import numpy as np
 from cv2.typing import MatLike
 
 from .config import HsvConfig, VisionConfig
@@ -111,6 +112,7 @@ RIM_LOOKS = 6  # blobs held down by their arcs or ring measured again with their
 CIRCLE_BLOBS = 2  # the largest search blobs the circle look searches
 NEAR_GAIN = 0.4  # a tracked ball's closer look: the V bound this much lower (under the second look's reach)...
 NEAR_MARGIN = 0.1  # ...in a window this share of the frame's width wider than the ball on each side
+SEARCH_BUFFERS = 4  # search buffer pairs kept at most
 AIM_SPAN, AIM_SHARE = 0.35, 0.8  # the aim point's window (of the ball's diameter), and its share of target colour
 
 
@@ -129,6 +131,7 @@ class HsvBlobDetector(WindowRefiner):
         self._blobs: list[SearchBlob] = []  # the first look's search blobs, where the circle look searches
         self._tried: set[tuple[float, Box]] = set()  # the first look's blobs split or cut by edges (area, box)
         self._plain_ok: dict[int, Features] = {}  # this frame's blobs found plain inside (by id, kept alive)
+        self._buffers: dict[tuple[int, int, int], tuple[MatLike, ...]] = {}  # the search's (width, height, look)
 
     @property
     def single_range(self) -> bool:
@@ -158,7 +161,7 @@ class HsvBlobDetector(WindowRefiner):
             if self._enough(found, w):
                 return found
         if (smooth := smoothed(image)) is not None:  # a noisy frame (pilot/hsv_noise.py)
-            s_small, s_bounds, s_hsv = self._search(smooth, scale)
+            s_small, s_bounds, s_hsv = self._search(smooth, scale, look=1)
             found = self._plain(image, self._again(smooth, s_bounds, s_small, s_hsv, scale, found, splits=True))
             if self._enough(found, w):
                 return found
@@ -180,12 +183,21 @@ class HsvBlobDetector(WindowRefiner):
             out.append(f)
         return out
 
-    def _search(self, image: MatLike, scale: int) -> tuple[MatLike, Bounds, MatLike]:
-        """The search's frame (``scale`` times smaller), its bounds for the frame's exposure, and its HSV."""
+    def _search(self, image: MatLike, scale: int, look: int = 0) -> tuple[MatLike, Bounds, MatLike]:
+        """The search's frame (``scale`` times smaller), its bounds for the frame's exposure, and its HSV, in
+        buffers kept from frame to frame (allocating them cost 2-3 % of a frame); ``look``: 0 for the frame, 1 for
+        its smoothed copy, which must not overwrite the first look's (a rim look measures its blobs again)."""
         w, h = frame_size(image)
-        small = cv2.resize(image, (w // scale, h // scale), interpolation=cv2.INTER_AREA) if scale > 1 else image
+        size = (w // scale, h // scale)
+        buffers = self._buffers.get((*size, look))
+        if buffers is None:
+            if len(self._buffers) >= SEARCH_BUFFERS:  # frame sizes changing: keep the newest only
+                self._buffers.clear()
+            buffers = tuple(np.empty((size[1], size[0], 3), np.uint8) for _ in range(2))
+            self._buffers[(*size, look)] = buffers
+        small = cv2.resize(image, size, dst=buffers[0], interpolation=cv2.INTER_AREA) if scale > 1 else image
         bounds = self.colour.bounds_for(small)  # the exposure read where the resize has just been: in cache
-        return small, bounds, cv2.cvtColor(small, self.colour.code)
+        return small, bounds, cv2.cvtColor(small, self.colour.code, dst=buffers[1])
 
     def _again(self, image: MatLike, bounds: Bounds, small: MatLike, small_hsv: MatLike, scale: int,
                found: list[Features], splits: bool, same_frame: bool = False) -> list[Features]:
