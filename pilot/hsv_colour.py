@@ -42,8 +42,8 @@ def darker(bounds: Bounds, gain: float) -> Bounds:
     return out
 
 
-def _in_range(hsv: MatLike, bounds: Bounds) -> MatLike:
-    mask = cv2.inRange(hsv, bounds[0][0], bounds[0][1])
+def _in_range(hsv: MatLike, bounds: Bounds, dst: MatLike | None = None) -> MatLike:
+    mask = cv2.inRange(hsv, bounds[0][0], bounds[0][1], dst=dst)
     for lo, hi in bounds[1:]:
         mask = cv2.bitwise_or(mask, cv2.inRange(hsv, lo, hi))
     return mask
@@ -137,8 +137,9 @@ class ColourMask:
         return self.in_range(cv2.cvtColor(image, self.code), bounds)
 
     @staticmethod
-    def in_range(hsv: MatLike, bounds: Bounds) -> MatLike:
-        return bounds.mask(hsv) if isinstance(bounds, Grown) else _in_range(hsv, bounds)
+    def in_range(hsv: MatLike, bounds: Bounds, dst: MatLike | None = None) -> MatLike:
+        """The mask of ``bounds`` (written into ``dst`` where it can be: not a grown one)."""
+        return bounds.mask(hsv) if isinstance(bounds, Grown) else _in_range(hsv, bounds, dst)
 
     def clean(self, mask: MatLike) -> MatLike:
         if self.kernel is None:
