@@ -197,7 +197,7 @@ class HsvBlobDetector(WindowRefiner):
     def _reused(self, size: tuple[int, int], slot: int, channels: int) -> tuple[MatLike, ...]:
         """Two buffers of ``size`` kept from frame to frame, for the search's ``slot`` (0 and 1: a frame and its HSV,
         see ``_search``; 2: the first look's mask before and after its opening). Written into, not allocated, they
-        stay in the caches: 4-5 % of a frame at 320x240."""
+        stay in the caches: 3-4 % of a frame at 320x240."""
         key = (*size, slot)
         buffers = self._buffers.get(key)
         if buffers is None:
