@@ -170,5 +170,5 @@ class ColourMask:
         if smooth > 0.0:
             roi = cv2.GaussianBlur(roi, (0, 0), smooth)
         roi = roi[m: roi.shape[0] - m, m: roi.shape[1] - m]
-        mask = self.raw(np.ascontiguousarray(roi), darker(self.bounds_for(image), gain))
+        mask = self.raw(roi, darker(self.bounds_for(image), gain))  # a view: OpenCV reads its rows in place
         return cv2.countNonZero(mask) / mask.size

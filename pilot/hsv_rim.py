@@ -108,7 +108,7 @@ def _counts(bgr: MatLike, cx: float, cy: float, r: float, colour: bool) -> npt.N
     x1, y1 = x0 + (x1 - x0) // k * k, y0 + (y1 - y0) // k * k
     if x1 - x0 < 3 * k or y1 - y0 < 3 * k:
         return None
-    roi = np.ascontiguousarray(bgr[y0:y1, x0:x1])
+    roi = bgr[y0:y1, x0:x1]  # a view: OpenCV reads its rows in place
     img = roi if colour else cv2.cvtColor(roi, cv2.COLOR_BGR2GRAY)
     if k > 1:
         img = cv2.resize(img, ((x1 - x0) // k, (y1 - y0) // k), interpolation=cv2.INTER_AREA)
