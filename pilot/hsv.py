@@ -70,7 +70,10 @@ ball on a textured surface of its colour, which even the edges cut into pieces (
 is one blob with that surface; only its rim tells it apart. It costs about 1 ms a window, in frames with no ball.
 
 Every look drops the blobs from ``hsv_inside.FROM`` px across that are brightness edges inside (pilot/hsv_inside.py):
-a round texture of the target's colour (a dahlia's heart, its red cups merged by JPEG's blocks), not a plain ball.
+a round texture of the target's colour (a dahlia's heart, its red cups merged by JPEG's blocks), not a plain ball;
+and the blobs measured on their rim that are hollow (pilot/hsv_hollow.py): brighter than their middle, in the
+target's colour, further round than a ball lit from one side can be (a dahlia's single cup under blur, whose lit
+wall is a brightness edge all round).
 
 A tracked ball the frame's look misses gets a closer look where the track expects it (``candidates_near``, called
 by pilot/detect.py): that window refined with the V bound ``NEAR_GAIN`` times as high.
@@ -91,6 +94,7 @@ from .config import HsvConfig, VisionConfig
 from .detection import Candidate, Detection, best_detection, frame_size
 from .hsv_circles import circle_features
 from .hsv_colour import Bounds, darker, grown
+from .hsv_hollow import hollow
 from .hsv_inside import busy_inside
 from .hsv_measure import HALF_DECIDES
 from .hsv_noise import smoothed
@@ -152,32 +156,36 @@ class HsvBlobDetector(WindowRefiner):
         self._plain_ok.clear()
         scale = 2 if w >= SEARCH_MIN_WIDTH else 1
         small, bounds, small_hsv = self._search(image, scale)
-        found = self._plain(image, self._look(image, bounds, small, small_hsv, scale))
+        found = self._plain(image, bounds, self._look(image, bounds, small, small_hsv, scale))
         if self._enough(found, w):
             return found
         if (lower := grown(bounds, SECOND_LOOK_GAIN)) is not None:  # not at the floor
-            found = self._plain(image, self._again(image, lower, small, small_hsv, scale, found, splits=True,
+            found = self._plain(image, bounds, self._again(image, lower, small, small_hsv, scale, found, splits=True,
                                                    same_frame=True))
             if self._enough(found, w):
                 return found
         if (smooth := smoothed(image)) is not None:  # a noisy frame (pilot/hsv_noise.py)
             s_small, s_bounds, s_hsv = self._search(smooth, scale, look=1)
-            found = self._plain(image, self._again(smooth, s_bounds, s_small, s_hsv, scale, found, splits=True))
+            found = self._plain(image, bounds, self._again(smooth, s_bounds, s_small, s_hsv, scale, found,
+                                                           splits=True))
             if self._enough(found, w):
                 return found
-        found = self._plain(image, self._rim_look(found))
+        found = self._plain(image, bounds, self._rim_look(found))
         if self._enough(found, w):
             return found
-        return found + self._plain(image, self._circle_look(image, bounds, found))
+        return found + self._plain(image, bounds, self._circle_look(image, bounds, found))
 
-    def _plain(self, image: MatLike, found: list[Features]) -> list[Features]:
-        """``found`` without the blobs a candidate could come of that are brightness edges inside: a texture of the
-        target's colour, not a ball (pilot/hsv_inside.py; checked once each)."""
+    def _plain(self, image: MatLike, bounds: Bounds, found: list[Features]) -> list[Features]:
+        """``found`` without the blobs a candidate could come of that are brightness edges inside, a texture of the
+        target's colour (pilot/hsv_inside.py), or measured on their rim and hollow, a cup of its colour
+        (pilot/hsv_hollow.py, in the colour of ``bounds``): not balls. Checked once each."""
         w = self._width
         out = []
         for f in found:
             if id(f) not in self._plain_ok:
-                if self.score(f, w) >= self.cfg.min_score and busy_inside(image, f.cx, f.cy, f.size):
+                if self.score(f, w) >= self.cfg.min_score and (
+                        busy_inside(image, f.cx, f.cy, f.size)
+                        or (f.rim > 0.0 and hollow(image, self.colour, bounds, f.cx, f.cy, f.size))):
                     continue
                 self._plain_ok[id(f)] = f
             out.append(f)
@@ -331,8 +339,9 @@ class HsvBlobDetector(WindowRefiner):
         x1, y1 = min(w, int(cx + half) + 1), min(h, int(cy + half) + 1)
         if x1 - x0 < 2 or y1 - y0 < 2:
             return []
-        found = self._refine(image, darker(self.colour.bounds_for(image), NEAR_GAIN), (x0, y0, x1 - x0, y1 - y0))
-        return self._ranked(self._plain(image, found), w)
+        near = darker(self.colour.bounds_for(image), NEAR_GAIN)
+        found = self._refine(image, near, (x0, y0, x1 - x0, y1 - y0))
+        return self._ranked(self._plain(image, near, found), w)
 
     def detect(self, image: MatLike) -> Detection:
         """This frame alone, the best candidate (no tracking, no frame checks)."""
