@@ -9,7 +9,7 @@ two opposite sides at once (rim lighting) would read hollow too; a room's lights
 
 Read on ``SECTORS`` sectors at ``RADII`` of the blob's radius, each sector's samples' grey against the mean grey of
 the middle's. A sector is lit when it is brighter by ``MARGIN`` and of the target's colour (an occluder in front of
-the ball is not the ball: the bench's 30 % occlusions read up to 9 of 12 sectors brighter otherwise). Hollow: at
+the ball is not the ball: otherwise 97 of the bench's 30 % occluded balls on the dev seeds read 7-10 of 12). Hollow: at
 least ``HOLLOW_SECTORS`` lit, spread over at least ``HOLLOW_SPREAD`` sectors in a row. A lit ball has 6 of 12 at
 most, in a row; a motion-blurred ball of 16-20 px on a bright background reads 7-8 in a row (its background blurs
 into its rim), the dahlia's cups 7-10 in two arcs or one of 9 and more.

@@ -52,7 +52,7 @@ def test_a_ball_lit_from_any_one_side_is_not_hollow(elevation: float) -> None:
 
 def test_a_red_cup_is_hollow_and_its_ball_is_not() -> None:
     """A red cup seen from the front, its wall lit and its inside in shade (brighter from the middle out), is
-    hollow; the same cup behind a grey occluder's edge is still read on what shows of it."""
+    hollow; a ball of the same red and size, lit from the upper left, is not."""
     yy, xx = np.mgrid[0:90, 0:120].astype(np.float64)
     rho = np.hypot(xx - 60, yy - 45) / 12.0
     shade = np.where(rho < 1.0, 0.35 + 0.65 * np.clip(rho, 0.0, 1.0), 0.0)[..., None]
