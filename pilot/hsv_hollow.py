@@ -30,6 +30,7 @@ import numpy.typing as npt
 from cv2.typing import MatLike
 
 from .hsv_colour import Bounds, ColourMask
+from .hsv_shape import unit_circle
 
 SECTORS = 12
 RADII = (0.45, 0.575, 0.7)  # of the radius, three (added one by one): inside the rim's blur, clear of the middle
@@ -41,10 +42,10 @@ IN_COLOUR = 2  # of the sector's len(RADII) samples: the sector is of the target
 
 OFFSETS_KEPT = 256  # sample offsets kept (by frame width and diameter in whole pixels)
 
-_ANGLES = np.linspace(0.0, 2.0 * np.pi, SECTORS, endpoint=False)
-_UNIT_X = np.concatenate((np.outer(RADII, np.cos(_ANGLES)).ravel(), (0.0, 1.0, -1.0, 0.0, 0.0)))
-_UNIT_Y = np.concatenate((np.outer(RADII, np.sin(_ANGLES)).ravel(), (0.0, 0.0, 0.0, 1.0, -1.0)))
-_RING = len(RADII) * SECTORS  # the ring's samples come first (row by radius, column by sector), then the middle's
+_MIDDLE_POINTS = ((0.0, 0.0), (1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0))  # in CENTRE radii
+# the ring's samples (row by radius, column by sector), then the middle's
+_UNIT_X, _UNIT_Y = np.concatenate([k * unit_circle(SECTORS) for k in RADII] + [np.array(_MIDDLE_POINTS)]).T
+_RING = len(RADII) * SECTORS
 _MIDDLE = len(_UNIT_X) - _RING
 _offsets: dict[tuple[int, int], tuple[npt.NDArray[np.intp], npt.NDArray[np.intp], npt.NDArray[np.intp], int]] = {}
 
