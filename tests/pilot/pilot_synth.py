@@ -61,14 +61,18 @@ def paste_marker(bg: Image, marker: Image, cx: int, cy: int) -> Image:
     return img
 
 
+UPPER_LEFT = (-0.5, -0.5, math.sqrt(0.5))  # a light's unit direction: x right, y down, z towards the camera
+
+
 def matte_ball(bg: FloatImage, cx: float, cy: float, r: float, colour: tuple[float, float, float],
-               ambient: float) -> FloatImage:
-    """``bg`` (BGR, float) with a matte ball of radius ``r`` at (cx, cy), lit from the upper left: ``colour`` (BGR)
-    where the light falls square on it, ``ambient`` of it on its shaded side; its rim anti-aliased."""
+               ambient: float, light: tuple[float, float, float] = UPPER_LEFT) -> FloatImage:
+    """``bg`` (BGR, float) with a matte ball of radius ``r`` at (cx, cy), lit from ``light`` (a unit vector):
+    ``colour`` (BGR) where the light falls square on it, ``ambient`` of it on its shaded side; its rim
+    anti-aliased."""
     yy, xx = np.mgrid[0 : bg.shape[0], 0 : bg.shape[1]].astype(np.float64)
     dx, dy = (xx - cx) / r, (yy - cy) / r
     nz = np.sqrt(np.clip(1.0 - dx * dx - dy * dy, 0.0, 1.0))
-    lit = np.clip(-0.5 * dx - 0.5 * dy + math.sqrt(0.5) * nz, 0.0, 1.0)
+    lit = np.clip(light[0] * dx + light[1] * dy + light[2] * nz, 0.0, 1.0)
     ball = (ambient + (1.0 - ambient) * lit)[..., None] * np.array(colour, np.float64)
     alpha = np.clip(r + 0.5 - np.hypot(xx - cx, yy - cy), 0.0, 1.0)[..., None]
     return np.asarray(bg * (1.0 - alpha) + ball * alpha, np.float64)

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import vision_eval as ve
 import vision_imagery as vi
+from pilot_synth import matte_ball
 
 import pilot.hsv as hsv
 import pilot.hsv_hollow as hsv_hollow
@@ -17,21 +18,16 @@ from pilot.config import ControllerConfig, HsvConfig
 from pilot.hsv_colour import ColourMask
 
 THRESHOLD = ControllerConfig().acquire_confidence
-RED = np.array((40.0, 40.0, 210.0))  # BGR where the light falls square on it
+RED = (40.0, 40.0, 210.0)  # BGR where the light falls square on it
 COLOUR = ColourMask(HsvConfig())
 
 
-def lit_ball(light: tuple[float, float, float], r: float = 12.0, ambient: float = 0.3, back: float = 120.0,
-             size: tuple[int, int] = (120, 90), at: tuple[float, float] = (60.0, 45.0)) -> np.ndarray:
-    """A matte red ball of radius ``r`` lit by one light from ``light`` (x right, y down, z towards the camera)
-    and an even ``ambient`` share, on a grey background of ``back``; its rim anti-aliased."""
-    lx, ly, lz = np.array(light) / np.linalg.norm(light)
-    yy, xx = np.mgrid[0 : size[1], 0 : size[0]].astype(np.float64)
-    dx, dy = (xx - at[0]) / r, (yy - at[1]) / r
-    nz = np.sqrt(np.clip(1.0 - dx * dx - dy * dy, 0.0, 1.0))
-    shade = ambient + (1.0 - ambient) * np.clip(lx * dx + ly * dy + lz * nz, 0.0, 1.0)
-    alpha = np.clip(r + 0.5 - np.hypot(xx - at[0], yy - at[1]), 0.0, 1.0)[..., None]
-    img = np.full((size[1], size[0], 3), back) * (1.0 - alpha) + shade[..., None] * RED * alpha
+def lit_ball(light: tuple[float, float, float], ambient: float = 0.3, back: float = 120.0,
+             at: tuple[float, float] = (60.0, 45.0)) -> np.ndarray:
+    """A matte red ball 24 px across lit from ``light`` (x right, y down, z towards the camera) and an even
+    ``ambient`` share, on a 120x90 grey background of ``back``."""
+    unit = np.array(light) / np.linalg.norm(light)
+    img = matte_ball(np.full((90, 120, 3), back), at[0], at[1], 12.0, RED, ambient, (unit[0], unit[1], unit[2]))
     return np.asarray(np.clip(img, 0, 255), np.uint8)
 
 
@@ -56,7 +52,7 @@ def test_a_red_cup_is_hollow_and_its_ball_is_not() -> None:
     yy, xx = np.mgrid[0:90, 0:120].astype(np.float64)
     rho = np.hypot(xx - 60, yy - 45) / 12.0
     shade = np.where(rho < 1.0, 0.35 + 0.65 * np.clip(rho, 0.0, 1.0), 0.0)[..., None]
-    cup = np.full((90, 120, 3), 120.0) * (rho >= 1.0)[..., None] + shade * RED
+    cup = np.full((90, 120, 3), 120.0) * (rho >= 1.0)[..., None] + shade * np.array(RED)
     cup = np.asarray(cup, np.uint8)
     assert is_hollow(cup)
     assert not is_hollow(lit_ball((-0.5, -0.5, 0.7)))
