@@ -13,7 +13,8 @@ from pilot_synth import RED, background
 
 import pilot.hsv_measure as hsv_measure
 from pilot.hsv import HsvBlobDetector
-from pilot.hsv_texture import PEERS, textured
+from pilot.hsv_score import SIZE
+from pilot.hsv_texture import PEERS, PEERS_SMALL, textured
 
 CX, CY, R = 160, 120, 10
 
@@ -38,6 +39,26 @@ def test_a_polka_dot_print_is_not_a_ball(spacing: int, monkeypatch: pytest.Monke
     assert not fires(img)
     monkeypatch.setattr(hsv_measure, "textured", lambda *_: False)
     assert fires(img)  # each dot alone would be one
+
+
+def small_dots(n: int) -> np.ndarray:
+    """``n`` red discs 15 px across (under SIZE's one), 40 px apart round the frame's centre."""
+    img = background(320, 240)
+    for a in np.linspace(0.0, 2.0 * math.pi, n, endpoint=False):
+        cv2.circle(img, (round(CX + 23 * math.cos(a)), round(CY + 23 * math.sin(a))), 7, RED, -1, lineType=cv2.LINE_AA)
+    return img
+
+
+def test_three_small_dots_are_a_pattern(monkeypatch: pytest.MonkeyPatch) -> None:
+    # each has PEERS_SMALL of its size within REACH diameters: a flower's cups, not three balls side by side
+    img = small_dots(PEERS_SMALL + 1)
+    assert not fires(img)
+    monkeypatch.setattr(hsv_measure, "textured", lambda *_: False)
+    assert fires(img)  # each dot alone would be one
+
+
+def test_two_small_balls_are_balls() -> None:
+    assert fires(small_dots(PEERS_SMALL))  # one peer each
 
 
 def test_sparse_dots_are_balls() -> None:
@@ -74,5 +95,11 @@ def test_peers_are_counted_by_size_and_distance() -> None:
     assert not textured(100, 100, 20, [own, *far], 1)  # beyond REACH diameters
     small = [blob(x + 5, y + 5, 8) for _, _, (x, y, _, _) in ring]
     assert not textured(100, 100, 20, [own, *small], 1)  # not its size
+    # under SIZE's one, PEERS_SMALL make a pattern; at it, they do not
+    small_own, at_one = blob(100, 100, 16), blob(100, 100, int(SIZE[1]))
+    pair = [blob(100 + 40 * math.cos(a), 100 + 40 * math.sin(a), 16) for a in (0.0, 2.0)]
+    assert textured(100, 100, 16, [small_own, *pair[:PEERS_SMALL]], 1)
+    assert not textured(100, 100, 16, [small_own, *pair[: PEERS_SMALL - 1]], 1)
+    assert not textured(100, 100, SIZE[1], [at_one, *pair[:PEERS_SMALL]], 1)
     half = [blob(50 + 25 * math.cos(a), 50 + 25 * math.sin(a), 10) for a in np.linspace(0, 6, PEERS)]
     assert textured(100, 100, 20, [blob(50, 50, 10), *half], 2)  # the search at half resolution
