@@ -42,7 +42,8 @@ def test_a_polka_dot_print_is_not_a_ball(spacing: int, monkeypatch: pytest.Monke
 
 
 def small_dots(n: int) -> np.ndarray:
-    """``n`` red discs 15 px across (under SIZE's one), 40 px apart round the frame's centre."""
+    """``n`` red discs 15 px across (under SIZE's one) on a circle of 23 px radius round the frame's centre (three
+    are 40 px apart)."""
     img = background(320, 240)
     for a in np.linspace(0.0, 2.0 * math.pi, n, endpoint=False):
         cv2.circle(img, (round(CX + 23 * math.cos(a)), round(CY + 23 * math.sin(a))), 7, RED, -1, lineType=cv2.LINE_AA)
@@ -95,9 +96,9 @@ def test_peers_are_counted_by_size_and_distance() -> None:
     assert not textured(100, 100, 20, [own, *far], 1)  # beyond REACH diameters
     small = [blob(x + 5, y + 5, 8) for _, _, (x, y, _, _) in ring]
     assert not textured(100, 100, 20, [own, *small], 1)  # not its size
-    # under SIZE's one, PEERS_SMALL make a pattern; at it, they do not
+    # under SIZE's one, PEERS_SMALL peers make a pattern; at it, they do not
     small_own, at_one = blob(100, 100, 16), blob(100, 100, int(SIZE[1]))
-    pair = [blob(100 + 40 * math.cos(a), 100 + 40 * math.sin(a), 16) for a in (0.0, 2.0)]
+    pair = [blob(100 + 40 * math.cos(a), 100 + 40 * math.sin(a), 16) for a in np.linspace(0, 3, PEERS_SMALL)]
     assert textured(100, 100, 16, [small_own, *pair[:PEERS_SMALL]], 1)
     assert not textured(100, 100, 16, [small_own, *pair[: PEERS_SMALL - 1]], 1)
     assert not textured(100, 100, SIZE[1], [at_one, *pair[:PEERS_SMALL]], 1)
