@@ -20,7 +20,7 @@ from cv2.typing import MatLike
 from .config import HsvConfig, VisionConfig
 from .detection import range_of
 from .hsv_colour import ColourMask
-from .hsv_rim import climbed_rim
+from .hsv_rim import rim_support
 from .hsv_score import (
     ARC,
     ARC_TOL,
@@ -120,7 +120,7 @@ class BlobMeasure:
         # left is not deferred: its caller puts the widest disc's centre and size on it, a rim look would not)
         later = (hsv, mask, c, area, x0, y0, scale, bgr) \
             if bgr is not None and not (rim or decide or cut or r < RIM_MIN_R) else None
-        edge = climbed_rim(bgr, cx, cy, r) if rim and bgr is not None else 0.0
+        edge = rim_support(bgr, cx, cy, r, colour=True) if rim and bgr is not None else 0.0
         pts = c.reshape(-1, 2)
         dx, dy = pts[:, 0] - cx, pts[:, 1] - cy  # two coordinate arrays: fewer numpy calls than an N x 2 sum
         d2 = dx * dx + dy * dy

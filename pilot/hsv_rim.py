@@ -52,9 +52,6 @@ COLOUR_MIN = 0.88  # of the points (43 of 48), in one colour channel: more are e
 # and distractor views on the three dev seed sets, 0.88 none, nor 0.9 (with 7 balls fewer)
 COLOUR_FROM = 18.0  # px across: a smaller circle is measured in brightness only. A red lamp 15-17 px across on the
 # tuning photos' motorbike, a red ring round a yellow glow, has a colour rim all round
-CLIMB = 3  # times the best circle found is looked around again (``climbed_rim``). On 18,000 dev-seed views of
-# bench/vision's tuning and validation photos (not the report's seeds): 13 balls more of 7,298, none fewer, 1
-# distractor view more of 3,000 (a dahlia cup); with a moved circle counting short of WHOLE too, 2 views more
 
 _U = unit_circle(48)
 _FACTORS = np.array([k for k in SCALES for _ in SHIFTS for _ in SHIFTS])[:, None, None]
@@ -71,24 +68,6 @@ def rim_support(bgr: MatLike, cx: float, cy: float, r: float, colour: bool = Fal
         return best_rim(bgr, cx, cy, r, True)[0]
     counts = _counts(bgr, cx, cy, r, False)
     return 0.0 if counts is None else float(counts.max()) / len(_U)
-
-
-def climbed_rim(bgr: MatLike, cx: float, cy: float, r: float) -> float:
-    """``rim_support`` (in colour too) of the best circle near (cx, cy, r), looked for again round the best one found,
-    up to ``CLIMB`` times while its rim grows. A blob with a stub of something attached has its enclosing circle off
-    the ball, further than ``SHIFTS`` and ``SCALES`` reach. A circle moved from the first look's counts only with a
-    whole rim (``WHOLE``, the circle look's bar); short of that, the first look's rim counts."""
-    first = best = best_rim(bgr, cx, cy, r, True)
-    for _ in range(CLIMB):
-        rim, bx, by, br = best
-        if abs(bx - cx) < 0.5 and abs(by - cy) < 0.5 and abs(br - r) < 0.5:  # where it started
-            break
-        cx, cy, r = bx, by, br
-        again = best_rim(bgr, cx, cy, r, True)
-        if again[0] <= rim:
-            break
-        best = again
-    return best[0] if best[0] >= WHOLE else first[0]
 
 
 def best_rim(bgr: MatLike, cx: float, cy: float, r: float,

@@ -8,12 +8,11 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 import pytest
-from pilot_synth import background, matte_ball
 
 import pilot.hsv as hsv
 import pilot.hsv_measure as hsv_measure
 import pilot.hsv_rim as hsv_rim
-from pilot.hsv_rim import WHOLE, climbed_rim, rim_support
+from pilot.hsv_rim import rim_support
 from pilot.hsv_score import RIM
 
 Image = npt.NDArray[np.uint8]
@@ -63,11 +62,11 @@ def test_a_frayed_ball_is_found_by_its_rim_and_only_by_it(r: int, band: int, blo
 def test_a_plain_ball_never_pays_for_a_rim(monkeypatch: pytest.MonkeyPatch) -> None:
     calls: list[float] = []
 
-    def counted(bgr: Image, cx: float, cy: float, r: float) -> float:
+    def counted(bgr: Image, cx: float, cy: float, r: float, colour: bool = False) -> float:
         calls.append(r)
-        return climbed_rim(bgr, cx, cy, r)
+        return rim_support(bgr, cx, cy, r, colour)
 
-    monkeypatch.setattr(hsv_measure, "climbed_rim", counted)
+    monkeypatch.setattr(hsv_measure, "rim_support", counted)
     img = np.full((240, 320, 3), WALL, np.uint8)
     cv2.circle(img, (CX, CY), 16, RED, -1, cv2.LINE_AA)
     found = hsv.HsvBlobDetector().candidates(img)
@@ -96,30 +95,3 @@ def test_a_wide_blurred_rim_is_measured_at_half_resolution(monkeypatch: pytest.M
     assert max(rim_support(square, CX, CY, 30.0), rim_support(square, CX, CY, 30.0 * 1.414)) < RIM[0]
     monkeypatch.setattr(hsv_rim, "HALF_FROM", 1e9)  # at full resolution only
     assert rim_support(disc, CX, CY, 30.0) < RIM[0]
-
-
-def stubbed_ball(stub: int) -> tuple[Image, tuple[float, float, float]]:
-    """A shaded red ball 29 px across with a darker red bar ``stub`` px long attached to its right side, and the
-    enclosing circle of the two together in the mask (off the ball: the bar pulls it right and widens it)."""
-    img = np.clip(matte_ball(background(320, 240).astype(np.float64), CX, CY, 14.0, (40.0, 40.0, 210.0), 0.3),
-                  0, 255).astype(np.uint8)
-    cv2.rectangle(img, (CX + 10, CY - 4), (CX + 14 + stub, CY + 4), (40, 40, 150), -1)
-    contours, _ = cv2.findContours(hsv.HsvBlobDetector().mask(img), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
-    (cx, cy), r = cv2.minEnclosingCircle(max(contours, key=cv2.contourArea))
-    return img, (cx, cy, r)
-
-
-@pytest.mark.parametrize("stub", [8, 12, 16])
-def test_the_rim_look_climbs_from_a_stubbed_blobs_circle_to_the_balls(stub: int) -> None:
-    img, circle = stubbed_ball(stub)
-    assert circle[2] >= 18.0  # the enclosing circle is the blob's, well off the ball's 14.5 px
-    assert rim_support(img, *circle, colour=True) < WHOLE  # near that circle, the rim is broken where the bar is
-    assert climbed_rim(img, *circle) >= WHOLE  # moving to the best circle found, and again, reaches the ball's
-
-
-def test_a_climb_that_finds_no_whole_rim_keeps_the_first_rim() -> None:
-    img, circle = stubbed_ball(20)  # too far off for the climb to reach the ball
-    assert climbed_rim(img, *circle) == rim_support(img, *circle, colour=True) < WHOLE
-    plain = np.full((240, 320, 3), WALL, np.uint8)
-    cv2.circle(plain, (CX, CY), 16, RED, -1, cv2.LINE_AA)
-    assert climbed_rim(plain, CX, CY, 16.0) == rim_support(plain, CX, CY, 16.0, colour=True) >= WHOLE
