@@ -99,8 +99,8 @@ def test_peers_are_counted_by_size_and_distance() -> None:
     # under SIZE's one, PEERS_SMALL peers make a pattern; at it, they do not
     small_own, at_one = blob(100, 100, 16), blob(100, 100, int(SIZE[1]))
     pair = [blob(100 + 40 * math.cos(a), 100 + 40 * math.sin(a), 16) for a in np.linspace(0, 3, PEERS_SMALL)]
-    assert textured(100, 100, 16, [small_own, *pair[:PEERS_SMALL]], 1)
-    assert not textured(100, 100, 16, [small_own, *pair[: PEERS_SMALL - 1]], 1)
-    assert not textured(100, 100, SIZE[1], [at_one, *pair[:PEERS_SMALL]], 1)
+    assert textured(100, 100, 16, [small_own, *pair], 1)
+    assert not textured(100, 100, 16, [small_own, *pair[:-1]], 1)  # one short
+    assert not textured(100, 100, SIZE[1], [at_one, *pair], 1)
     half = [blob(50 + 25 * math.cos(a), 50 + 25 * math.sin(a), 10) for a in np.linspace(0, 6, PEERS)]
     assert textured(100, 100, 20, [blob(50, 50, 10), *half], 2)  # the search at half resolution
