@@ -36,7 +36,9 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
    ``SPLIT_FILL`` of their box's disc are split (pilot/hsv_split.py): by shape, around the widest discs that
    bulge out of them, the mask opened by a disc half as wide (necks go, the ball stays whole; its arcs count
    only on the mask's real edge, as an opened square is round); and by hue, when their pixels fall in two hue
-   classes (a ball a few units off a red-brown saucer), each class's round pieces refined in its own range.
+   classes (a ball a few units off a red-brown saucer), each class's round pieces refined in its own range, or
+   else by saturation (a crimson ball on a glossy orange-red saucer of its hue), each piece then counting only
+   with a rim all round (pilot/hsv_rim.py) and not in a pattern of round pieces of its size.
 4. Edges: a ball on a surface of its colour (a red-brown saucer, a red motorbike's tank) is in one piece with
    it even in hue; if still nothing scores ``SPLIT_UNLESS``, the largest search blobs' windows are cut by the
    image's edges (pilot/hsv_edges.py) and the round pieces from ``hsv_edges.MIN_SIZE`` measured, isolation
@@ -307,7 +309,7 @@ class HsvBlobDetector(WindowRefiner):
                 self._tried.update((a, box) for a, _, box in joined)
             split = self._split(image, bounds, joined, scale, found)
             if len(bounds) == 1:
-                split += self._hue_split(image, bounds, small_hsv, mask, joined, scale, found + split)
+                split += self._colour_split(image, bounds, small_hsv, mask, joined, scale, found + split)
             found += split
             good = any(self.score(f, w) >= SPLIT_UNLESS for f in split)
         if blobs and not good:

@@ -13,9 +13,9 @@ from .detection import frame_size
 from .hsv_colour import Bounds
 from .hsv_edges import MIN_SIZE, WALL_GROWTH, cut_by_edges, walled_in
 from .hsv_measure import BlobMeasure
-from .hsv_rim import rim_support
+from .hsv_rim import WHOLE, best_rim, rim_support
 from .hsv_score import SIZE, Features
-from .hsv_split import disc_centres, hue_pieces, split_off
+from .hsv_split import HUE, colour_pieces, disc_centres, split_off
 from .hsv_texture import SearchBlob
 
 SEARCH_FILL = 0.45  # below FILL's zero: the search's coarser outline never rejects what the refinement keeps; a
@@ -66,17 +66,32 @@ class WindowRefiner(BlobMeasure):
                     out.append(f)
         return out
 
-    def _hue_split(self, image: MatLike, bounds: Bounds, hsv: MatLike, mask: MatLike,
-                   joined: list[SearchBlob], scale: int, found: list[Features]) -> list[Features]:
-        """Balls a few hue units off what they are joined to (a red ball on a red-brown saucer): the round pieces
-        of each hue class of the largest joined blobs (pilot/hsv_split.py), refined in that class's range (their
-        rings then see only their own hue). One range only (pilot/hsv_colour.py)."""
+    def _colour_split(self, image: MatLike, bounds: Bounds, hsv: MatLike, mask: MatLike,
+                      joined: list[SearchBlob], scale: int, found: list[Features]) -> list[Features]:
+        """Balls a few hue units off what they are joined to (a red ball on a red-brown saucer), or of the same hue
+        and less or more saturated: the round pieces of each class of the largest joined blobs (pilot/hsv_split.py),
+        refined in that class's range (their rings then see only their own class). One range only
+        (pilot/hsv_colour.py). A piece split by saturation counts only with a rim all round (``WHOLE``, in
+        brightness or colour), from ``SIZE``'s full size (18 px) as a piece cut by edges: a surface's shading and
+        gloss vary its saturation in patches, a ball differs from it at its outline. It is not deferred to the rim
+        look (its rim is read here), and keeps its rim, which the hollow check reads (a cup's wall is a rim too)."""
         min_area = self.cfg.min_area / (scale * scale)
         out: list[Features] = []
-        for sub, (px, py, pw, ph) in hue_pieces(hsv, mask, joined[:SPLIT_BLOBS], bounds, min_area, SEARCH_FILL,
-                                                self.colour.clean):
+        for sub, (px, py, pw, ph), channel in colour_pieces(hsv, mask, joined[:SPLIT_BLOBS], bounds, min_area,
+                                                            SEARCH_FILL, self.colour.clean):
             box = (px * scale, py * scale, pw * scale, ph * scale)
-            out += [f for f in self._refine(image, sub, box) if is_new(f, found + out)]
+            if channel == HUE:
+                out += [f for f in self._refine(image, sub, box) if is_new(f, found + out)]
+                continue
+            deferred = len(self.deferred)
+            pieces = self._refine(image, sub, box)
+            del self.deferred[deferred:]
+            for f in pieces:
+                if f.size < SIZE[1] or not is_new(f, found + out):
+                    continue
+                rim = best_rim(image, f.cx, f.cy, (f.size - 1.0) / 2.0, colour=True)[0]
+                if rim >= WHOLE:
+                    out.append(f._replace(rim=rim))
         return out
 
     def _split(self, image: MatLike, bounds: Bounds, joined: list[SearchBlob],

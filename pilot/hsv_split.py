@@ -1,6 +1,7 @@
 """Balls joined in the mask to something of their colour (pilot/hsv.py, step 3): the array work of splitting
-them off, by shape (a disc bulging out of a blob, cut free by an opening) and by hue (a ball a few hue units
-off the red-brown surface it lies on)."""
+them off, by shape (a disc bulging out of a blob, cut free by an opening), by hue (a ball a few hue units off the
+red-brown surface it lies on) and, where the hue is one, by saturation (a crimson ball on a glossy orange-red
+saucer of the same hue: the saucer's colour is purer)."""
 
 from __future__ import annotations
 
@@ -22,9 +23,14 @@ RIM_MIN = 0.35  # of a circle just outside a disc that leaves the blob: less is 
 # fits inside a wide region has its nearest edge on one side); it halves the discs refined, not the recall
 SPLIT_OPEN = 0.5  # the opening's disc, in radii of the disc found (0.6 let opened squares through: red_shape)
 SPLIT_CUT = 0.1  # the opening must cut off this much (of the piece's area): else the blob was joined to nothing
-HUE_PIECES = 2  # the largest round pieces of each hue class refined
+HUE_PIECES = 2  # the largest round pieces of each hue (or saturation) class refined
 HUE_GAP = 4.0  # hue units between the means of a blob's two hue classes (Otsu) for a split by hue (3: more
 # false detections on the tuning photos' empty views, 2: more still)
+SAT_GAP = 16.0  # saturation units between the means of a blob's two saturation classes for a split by saturation
+# (24 found nearly the same: a ball and the surface it is joined to differ by 20-50)
+PATTERN_RATIO = 1.5  # a saturation class with another round piece within this ratio of its largest's size is a
+# texture of round things (a dahlia's cups), not a ball on a surface: pilot/hsv_texture.py's SIZE_RATIO
+HUE, SATURATION = 0, 1  # the HSV channels a joined blob is split by
 
 _CIRCLE = unit_circle(24)
 _PEAK_KERNEL = np.ones((3, 3), np.uint8)
@@ -105,39 +111,56 @@ def split_off(mask: MatLike, cx: int, cy: int, r: float, min_area: float) -> Pie
     return None
 
 
-def hue_split(hue: npt.NDArray[np.uint8], blob: npt.NDArray[np.uint8], min_count: float) -> int | None:
-    """The hue (inclusive upper bound of the lower class) that splits a blob's pixels into two classes whose
-    means lie at least HUE_GAP apart, or None (one hue, or too few pixels)."""
-    values = hue[blob > 0]
-    if len(values) < min_count:
+def two_classes(values: npt.NDArray[np.uint8], blob: npt.NDArray[np.uint8], min_count: float, gap: float) -> int | None:
+    """The value (inclusive upper bound of the lower class) that splits a blob's pixels of one channel into two
+    classes (Otsu) whose means lie at least ``gap`` apart, or None (one class, or too few pixels)."""
+    inside = values[blob > 0]
+    if len(inside) < min_count:
         return None
-    t, _ = cv2.threshold(values.reshape(-1, 1), 0, 255, cv2.THRESH_BINARY + cv2.THRESH_OTSU)
-    low, high = values[values <= t], values[values > t]
-    if not len(low) or not len(high) or float(high.mean()) - float(low.mean()) < HUE_GAP:
+    t, _ = cv2.threshold(inside.reshape(-1, 1), 0, 255, cv2.THRESH_BINARY + cv2.THRESH_OTSU)
+    low, high = inside[inside <= t], inside[inside > t]
+    if not len(low) or not len(high) or float(high.mean()) - float(low.mean()) < gap:
         return None
     return int(t)
 
 
-def hue_pieces(hsv: MatLike, mask: MatLike, joined: Sequence[tuple[float, MatLike, Box]], bounds: Bounds,
-               min_area: float, min_fill: float, clean: Callable[[MatLike], MatLike]) -> Iterator[tuple[Bounds, Box]]:
+def colour_pieces(hsv: MatLike, mask: MatLike, joined: Sequence[tuple[float, MatLike, Box]], bounds: Bounds,
+                  min_area: float, min_fill: float,
+                  clean: Callable[[MatLike], MatLike]) -> Iterator[tuple[Bounds, Box, int]]:
     """For each joined blob (area, contour, box in the search ``hsv`` and its ``mask``) whose pixels fall in two hue
-    classes: each class's hue range (``bounds``, one range, narrowed) and the ``HUE_PIECES`` largest round pieces of
-    the blob in it (their boxes in the search; ``clean``: the detector's mask cleaning)."""
+    classes, or else in two saturation classes: each class's range (``bounds``, one range, narrowed in that
+    channel), the ``HUE_PIECES`` largest round pieces of the blob in it (their boxes in the search; ``clean``: the
+    detector's mask cleaning) and the channel split. A saturation class holding round pieces of a size is a texture
+    (``PATTERN_RATIO``): none of its pieces."""
     ((lo, hi),) = bounds
     for _, c, (x, y, bw, bh) in joined:
         blob = np.zeros((bh, bw), np.uint8)
         cv2.drawContours(blob, [c], -1, 255, -1, offset=(-x, -y))
         window = np.asarray(hsv, np.uint8)[y : y + bh, x : x + bw]
         blob &= np.asarray(mask, np.uint8)[y : y + bh, x : x + bw]
-        t = hue_split(np.ascontiguousarray(window[..., 0]), blob, 4 * min_area)
+        channel, t = HUE, two_classes(np.ascontiguousarray(window[..., HUE]), blob, 4 * min_area, HUE_GAP)
+        if t is None:
+            channel, t = SATURATION, two_classes(np.ascontiguousarray(window[..., SATURATION]), blob,
+                                                 4 * min_area, SAT_GAP)
         if t is None:
             continue
-        for h0, h1 in ((int(lo[0]), t), (t + 1, int(hi[0]))):
+        for v0, v1 in ((int(lo[channel]), t), (t + 1, int(hi[channel]))):
             sub_lo, sub_hi = lo.copy(), hi.copy()
-            sub_lo[0], sub_hi[0] = h0, h1
+            sub_lo[channel], sub_hi[channel] = v0, v1
             sub = clean(cv2.bitwise_and(cv2.inRange(window, sub_lo, sub_hi), blob))
-            for _, (px, py, pw, ph) in round_pieces(sub, min_area, min_fill)[:HUE_PIECES]:
-                yield [(sub_lo, sub_hi)], (px + x, py + y, pw, ph)
+            pieces = round_pieces(sub, min_area, min_fill)
+            if channel == SATURATION and _patterned(pieces):
+                continue
+            for _, (px, py, pw, ph) in pieces[:HUE_PIECES]:
+                yield [(sub_lo, sub_hi)], (px + x, py + y, pw, ph), channel
+
+
+def _patterned(pieces: list[tuple[float, Box]]) -> bool:
+    """Whether the largest of ``pieces`` (largest first) has another of a similar size (``PATTERN_RATIO``)."""
+    if len(pieces) < 2:
+        return False
+    sizes = [max(bw, bh) for _, (_, _, bw, bh) in pieces]
+    return any(sizes[0] / PATTERN_RATIO <= s <= sizes[0] * PATTERN_RATIO for s in sizes[1:])
 
 
 def round_pieces(mask: MatLike, min_area: float, min_fill: float) -> list[tuple[float, Box]]:
