@@ -16,6 +16,7 @@ from cv2.typing import MatLike
 
 from .hsv_colour import Bounds
 from .hsv_shape import unit_circle
+from .hsv_texture import SIZE_RATIO
 
 PEAK_MIN = 3.0  # pixels: a disc centre nearer than this to the blob's edge is too small to be a ball
 PEAKS_PER_BLOB = 6  # disc centres looked at per blob, widest first
@@ -28,8 +29,6 @@ HUE_GAP = 4.0  # hue units between the means of a blob's two hue classes (Otsu) 
 # false detections on the tuning photos' empty views, 2: more still)
 SAT_GAP = 16.0  # saturation units between the means of a blob's two saturation classes for a split by saturation
 # (24 found nearly the same: a ball and the surface it is joined to differ by 20-50)
-PATTERN_RATIO = 1.5  # a saturation class with another round piece within this ratio of its largest's size is a
-# texture of round things (a dahlia's cups), not a ball on a surface: pilot/hsv_texture.py's SIZE_RATIO
 HUE, SATURATION = 0, 1  # the HSV channels a joined blob is split by
 
 _CIRCLE = unit_circle(24)
@@ -131,7 +130,7 @@ def colour_pieces(hsv: MatLike, mask: MatLike, joined: Sequence[tuple[float, Mat
     classes, or else in two saturation classes: each class's range (``bounds``, one range, narrowed in that
     channel), the ``HUE_PIECES`` largest round pieces of the blob in it (their boxes in the search; ``clean``: the
     detector's mask cleaning) and the channel split. A saturation class holding round pieces of a size is a texture
-    (``PATTERN_RATIO``): none of its pieces."""
+    of round things (a dahlia's cups), not a ball on a surface: none of its pieces."""
     ((lo, hi),) = bounds
     for _, c, (x, y, bw, bh) in joined:
         blob = np.zeros((bh, bw), np.uint8)
@@ -156,11 +155,12 @@ def colour_pieces(hsv: MatLike, mask: MatLike, joined: Sequence[tuple[float, Mat
 
 
 def _patterned(pieces: list[tuple[float, Box]]) -> bool:
-    """Whether the largest of ``pieces`` (largest first) has another of a similar size (``PATTERN_RATIO``)."""
+    """Whether the largest of ``pieces`` (largest first) has another of a similar size: within the texture check's
+    ``SIZE_RATIO`` (pilot/hsv_texture.py)."""
     if len(pieces) < 2:
         return False
     sizes = [max(bw, bh) for _, (_, _, bw, bh) in pieces]
-    return any(sizes[0] / PATTERN_RATIO <= s <= sizes[0] * PATTERN_RATIO for s in sizes[1:])
+    return any(sizes[0] / SIZE_RATIO <= s <= sizes[0] * SIZE_RATIO for s in sizes[1:])
 
 
 def round_pieces(mask: MatLike, min_area: float, min_fill: float) -> list[tuple[float, Box]]:
