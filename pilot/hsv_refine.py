@@ -13,7 +13,7 @@ from .detection import frame_size
 from .hsv_colour import Bounds
 from .hsv_edges import MIN_SIZE, WALL_GROWTH, cut_by_edges, walled_in
 from .hsv_measure import BlobMeasure
-from .hsv_rim import WHOLE, best_rim, rim_support
+from .hsv_rim import WHOLE, rim_support
 from .hsv_score import SIZE, Features
 from .hsv_split import HUE, colour_pieces, disc_centres, split_off
 from .hsv_texture import SearchBlob
@@ -89,7 +89,7 @@ class WindowRefiner(BlobMeasure):
             for f in pieces:
                 if f.size < SIZE[1] or not is_new(f, found + out):
                     continue
-                rim = best_rim(image, f.cx, f.cy, (f.size - 1.0) / 2.0, colour=True)[0]
+                rim = rim_support(image, f.cx, f.cy, (f.size - 1.0) / 2.0, colour=True)
                 if rim >= WHOLE:
                     out.append(f._replace(rim=rim))
         return out

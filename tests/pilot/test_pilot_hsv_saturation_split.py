@@ -17,14 +17,20 @@ BALL = (45.0, 60.0, 215.0)  # hue 3 (under HUE_GAP from the surface's), saturati
 CX, CY, R = 150.0, 110.0, 14.0
 
 
+def saucer() -> np.ndarray:
+    """Where the saucer lies in the frame: an ellipse."""
+    mask = np.zeros((240, 320), np.uint8)
+    cv2.ellipse(mask, (160, 120), (140, 75), 0.0, 0.0, 360.0, 255, -1)
+    return mask
+
+
 def surface() -> np.ndarray:
-    """A grey table with a saucer on it: an ellipse of the surface, its brightness falling off from left to right
-    (its hue and saturation the same everywhere)."""
+    """A grey table with a saucer on it: the surface, its brightness falling off from left to right (its hue and
+    saturation the same everywhere)."""
     img = np.full((240, 320, 3), 120.0)
-    saucer = np.zeros((240, 320), np.uint8)
-    cv2.ellipse(saucer, (160, 120), (140, 75), 0.0, 0.0, 360.0, 255, -1)
+    on = saucer() > 0
     shade = np.linspace(1.05, 0.8, 320)[None, :, None]
-    img[saucer > 0] = (np.ones((240, 320, 1)) * shade * np.array(SURFACE))[saucer > 0]
+    img[on] = (np.ones((240, 320, 1)) * shade * np.array(SURFACE))[on]
     return img
 
 
@@ -44,8 +50,7 @@ def test_the_frame_is_one_blob_in_hue() -> None:
     """The premise: the ball and the surface are both in the target's range, in one hue class."""
     img = frame([(CX, CY)])
     hsv = cv2.cvtColor(img, cv2.COLOR_RGB2HSV)  # the detector's mirrored hue (red at 120)
-    mask = np.zeros((240, 320), np.uint8)
-    cv2.ellipse(mask, (160, 120), (140, 75), 0.0, 0.0, 360.0, 255, -1)
+    mask = saucer()
     assert hsv_split.two_classes(np.ascontiguousarray(hsv[..., 0]), mask, 100, hsv_split.HUE_GAP) is None
     assert hsv_split.two_classes(np.ascontiguousarray(hsv[..., 1]), mask, 100, hsv_split.SAT_GAP) is not None
 
