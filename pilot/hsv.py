@@ -66,10 +66,11 @@ JPEG's colour blocks, noise or shade) and for isolation (a ball on a surface of 
 under ``hsv_edges.MIN_SIZE`` count with a brightness rim of ``hsv_refine.SMALL_RIM``.
 
 A frame where still nothing scores ``SECOND_LOOK_UNLESS`` gets a circle look (pilot/hsv_circles.py): in the first
-look's ``CIRCLE_BLOBS`` largest blobs' windows, circles of brightness edges (the best of each octave of radii) with
-the target's colour inside (one circle to a window: several are a texture of round things, a flower's petals). A
-ball on a textured surface of its colour, which even the edges cut into pieces (its shading is an edge inside it),
-is one blob with that surface; only its rim tells it apart. It costs about 1 ms a window, in frames with no ball.
+look's ``CIRCLE_BLOBS`` largest blobs' windows, circles of brightness edges, then of colour edges (the best of each
+octave of radii), with the target's colour inside (one circle to a window: several are a texture of round things, a
+flower's petals). A ball on a textured surface of its colour, which even the edges cut into pieces (its shading is
+an edge inside it), is one blob with that surface; only its rim tells it apart. It costs about 2 ms a window, in
+frames with no ball.
 
 Every look drops the blobs from ``hsv_inside.FROM`` px across that are brightness edges inside (pilot/hsv_inside.py):
 a round texture of the target's colour (a dahlia's heart, its red cups merged by JPEG's blocks), not a plain ball;
