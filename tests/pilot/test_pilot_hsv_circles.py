@@ -1,7 +1,7 @@
 """The colour-ball detector's circle look (pilot/hsv_circles.py): a shaded ball lying on a textured surface of its
-own colour, which no mask separates, is found by the circle of brightness (or colour) edges round it, and only in a frame
-where nothing else is; a red square, an open arc, a hollow or a texture of round things on the same surface is not
-made a ball."""
+own colour, which no mask separates, is found by the circle of brightness (or colour) edges round it, and only in a
+frame where nothing else is; a red square, an open arc, a hollow or a texture of round things on the same surface is
+not made a ball."""
 
 from __future__ import annotations
 
