@@ -1,6 +1,6 @@
 """The colour-ball detector's fallback looks (pilot/hsv.py) measure again blobs the first look measured: a ball whose
 shaded side the first look's mask left out is whole in the second look's grown mask, at the same place. That better
-measure replaces the first one; a worse one does not."""
+measure replaces the first one; a worse one does not. So does a circle the circle look finds there."""
 
 from __future__ import annotations
 
@@ -63,3 +63,15 @@ def test_occluded_balls_found_whole_in_the_grown_mask(monkeypatch: pytest.Monkey
     found_before, empty_before = ve.counts(HsvBlobDetector().candidates, views, 0.6)
     assert found >= found_before + 3
     assert empty == empty_before == 0
+
+
+def test_a_circle_at_a_blob_measured_lower_replaces_it(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The circle look (pilot/hsv_circles.py) finds a ball whose mask JPEG frayed by its rim: at the place of that
+    blob's lower first measure."""
+    circle = PLAIN._replace(cx=100.5, rim=0.9)
+    monkeypatch.setattr(HsvBlobDetector, "_look", looks([HELD_DOWN], []))
+    monkeypatch.setattr(HsvBlobDetector, "_circle_look", lambda self, image, bounds: [circle])
+    frame = np.full((240, 320, 3), 200, np.uint8)
+    assert HsvBlobDetector().features(frame) == [circle]
+    monkeypatch.setattr(HsvBlobDetector, "_circle_look", lambda self, image, bounds: [HELD_DOWN._replace(arc=0.4)])
+    assert HsvBlobDetector().features(frame) == [HELD_DOWN]
