@@ -103,7 +103,7 @@ from .hsv_measure import HALF_DECIDES
 from .hsv_noise import smoothed
 from .hsv_refine import EDGE_BLOBS, SEARCH_FILL, SPLIT_BLOBS, Box, WindowRefiner, is_new
 from .hsv_score import SIZE, Features
-from .hsv_texture import SearchBlob
+from .hsv_texture import SearchBlob, textured
 
 MAX_CANDIDATES = 4  # the largest search blobs refined; smaller ones cannot be the nearest target
 SEARCH_MIN_WIDTH = 320  # frames at least this wide are searched at half resolution
@@ -237,9 +237,12 @@ class HsvBlobDetector(WindowRefiner):
         return found
 
     def _with(self, found: list[Features], f: Features, s: float) -> list[Features]:
-        """``found`` with ``f`` (scoring ``s``), which replaces those at its place if it scores more than each."""
+        """``found`` with ``f`` (scoring ``s``), which replaces those at its place if it scores more than each and
+        none of them is in a pattern of round things (the texture check, pilot/hsv_texture.py): measured again, a
+        dot of a print may read smaller, with fewer peers in reach, and the place stays a pattern."""
         same = [g for g in found if not is_new(f, [g])]
-        if any(s <= self.score(g, self._width) for g in same):
+        if any(s <= self.score(g, self._width) or textured(g.cx, g.cy, g.size, self.round_search, self.search_scale)
+               for g in same):
             return found
         return [g for g in found if is_new(f, [g])] + [f]
 

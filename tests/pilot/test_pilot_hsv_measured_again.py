@@ -11,6 +11,7 @@ import pytest
 import vision_eval as ve
 import vision_imagery as vi
 
+import pilot.hsv as hsv
 from pilot.hsv import SECOND_LOOK_MIN, SECOND_LOOK_UNLESS, HsvBlobDetector
 from pilot.hsv_score import Features
 
@@ -75,3 +76,12 @@ def test_a_circle_at_a_blob_measured_lower_replaces_it(monkeypatch: pytest.Monke
     assert HsvBlobDetector().features(frame) == [circle]
     monkeypatch.setattr(HsvBlobDetector, "_circle_look", lambda self, image, bounds: [HELD_DOWN._replace(arc=0.4)])
     assert HsvBlobDetector().features(frame) == [HELD_DOWN]
+
+
+def test_a_place_in_a_pattern_stays_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A dot of a polka-dot print measured again (a circle a little smaller, with fewer peers in reach) is still a
+    dot of the print: what is at a place the texture check calls a pattern is not replaced."""
+    monkeypatch.setattr(HsvBlobDetector, "_look", looks([HELD_DOWN], []))
+    monkeypatch.setattr(HsvBlobDetector, "_circle_look", lambda self, image, bounds: [PLAIN._replace(rim=0.9)])
+    monkeypatch.setattr(hsv, "textured", lambda cx, cy, size, blobs, scale: True)  # the place's reading only
+    assert HsvBlobDetector().features(np.full((240, 320, 3), 200, np.uint8)) == [HELD_DOWN]
