@@ -251,10 +251,11 @@ class HsvBlobDetector(WindowRefiner):
         return any(self.score(f, width) >= SECOND_LOOK_UNLESS for f in found)
 
     def _circle_look(self, image: MatLike, bounds: Bounds) -> list[Features]:
-        """The circles in the first look's largest blobs' windows (pilot/hsv_circles.py). Each replaces a blob
-        measured at its place if it scores more (``_with``): a ball whose mask JPEG or shade frayed, measured at 0.3-0.6
-        there, is a circle scoring 0.65-1 (until the twenty-fourth session the circle was dropped as no new blob; on
-        the five dev seed sets of bench/vision, 7 balls more, none fewer, the same false detections)."""
+        """The circles in the first look's largest blobs' windows (pilot/hsv_circles.py). ``features`` merges each,
+        once checked plain (``_plain``), with ``_with``: it replaces a blob measured at its place if it scores more (a
+        ball whose mask JPEG or shade frayed, measured at 0.3-0.6 there, is a circle scoring 0.65-1; until the
+        twenty-fourth session the circle was dropped as no new blob; on the five dev seed sets of bench/vision, 7 balls
+        more, none fewer, the same false detections)."""
         out: list[Features] = []
         k = self.search_scale
         for _, _, (x, y, bw, bh) in sorted(self._blobs, key=lambda b: b[0], reverse=True)[:CIRCLE_BLOBS]:
