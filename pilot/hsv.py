@@ -38,7 +38,11 @@ Search, then refine (the cost stays near the floor any colour detector pays, one
    only on the mask's real edge, as an opened square is round); and by hue, when their pixels fall in two hue
    classes (a ball a few units off a red-brown saucer), each class's round pieces refined in its own range, or
    else by saturation (a crimson ball on a glossy orange-red saucer of its hue), each piece then counting only
-   with a rim all round (pilot/hsv_rim.py) and not in a pattern of round pieces of its size.
+   with a rim all round (pilot/hsv_rim.py) and not in a pattern of round pieces of its size. A search blob that
+   measures as a ball there and gave nothing in its window may be joined at full resolution to a strip the
+   search's opening took off (a rail, a beam): it is split by shape too, its piece counting only with a full shape
+   score (an opening rounds a square's corners; on the dev seeds of bench/vision, 11 balls more of about 7,300,
+   none fewer, the same false detections).
 4. Edges: a ball on a surface of its colour (a red-brown saucer, a red motorbike's tank) is in one piece with
    it even in hue; if still nothing scores ``SPLIT_UNLESS``, the largest search blobs' windows are cut by the
    image's edges (pilot/hsv_edges.py) and the round pieces from ``hsv_edges.MIN_SIZE`` measured, isolation
@@ -102,7 +106,7 @@ from .hsv_inside import busy_inside
 from .hsv_measure import HALF_DECIDES
 from .hsv_noise import smoothed
 from .hsv_refine import EDGE_BLOBS, SEARCH_FILL, SPLIT_BLOBS, Box, WindowRefiner, is_new
-from .hsv_score import SIZE, Features
+from .hsv_score import SIZE, Features, arc_score
 from .hsv_texture import SearchBlob, textured
 
 MAX_CANDIDATES = 4  # the largest search blobs refined; smaller ones cannot be the nearest target
@@ -112,6 +116,8 @@ SPLIT_FILL = 0.75  # a search blob filling less of its box's disc may be a ball 
 HALF_TRY = 24  # px across: a smaller search blob is only refined; from this, first measured at half
 # resolution, where a plain disc scoring HALF_DECIDES (pilot/hsv_measure.py) skips the refinement
 SPLIT_UNLESS = 0.8  # a candidate scoring this already: no split (0.1-0.3 ms a disc or piece refined)
+UNREFINED_SHAPE = 1.0  # a piece split off a round search blob that its window did not measure counts only with a
+# full shape score (circle or ellipse): the opening that frees a ball from a stub rounds a square's corners too
 SECOND_LOOK_UNLESS = 0.6  # nothing scoring this (the default acquisition threshold): a second look...
 SECOND_LOOK_GAIN = 0.8  # ...with the V bound this much lower, grown (a ball's shaded side, a dim or backlit ball)...
 SECOND_LOOK_MIN = 0.75  # ...keeps what scores this: a fallback needs stronger evidence (tuning photos' empty views)
@@ -308,6 +314,7 @@ class HsvBlobDetector(WindowRefiner):
             self._blobs, self.round_search, self.search_scale = blobs, boxes, scale
             self._tried.clear()
         found: list[Features] = []
+        unrefined: list[SearchBlob] = []  # balls in the search, nothing measured in their windows
         for area, c, (x, y, bw, bh) in boxes[:MAX_CANDIDATES]:
             across = max(bw, bh) * scale if scale > 1 else 0  # searched at full resolution: refined as it is
             # below HALF_MEASURE, the look at half resolution counts only if it decides (and stops when it cannot)
@@ -320,14 +327,18 @@ class HsvBlobDetector(WindowRefiner):
                 fs = [half]
             else:
                 fs = self._refine(image, bounds, (x * scale, y * scale, bw * scale, bh * scale))
+                if not fs and scale > 1 and self.measure(small_hsv, mask, c, area, 0, 0, scale) is not None:
+                    unrefined.append((area, c, (x, y, bw, bh)))  # a ball in the search: joined in its window?
             found += [f for f in fs if is_new(f, found)]
         good = not splits or any(self.score(f, w) >= SPLIT_UNLESS for f in found)
-        if joined and not good:
+        if (joined or unrefined) and not good:
             joined.sort(key=lambda b: b[0], reverse=True)
-            joined = _untried(joined[:SPLIT_BLOBS], tried)
+            joined, unrefined = _untried(joined[:SPLIT_BLOBS], tried), _untried(unrefined, tried)
             if first:
-                self._tried.update((a, box) for a, _, box in joined)
+                self._tried.update((a, box) for a, _, box in joined + unrefined)
             split = self._split(image, bounds, joined, scale, found)
+            split += [f for f in self._split(image, bounds, unrefined, scale, found + split)
+                      if arc_score(f.arc, f.ellipse_arc) >= UNREFINED_SHAPE]
             if len(bounds) == 1:
                 split += self._colour_split(image, bounds, small_hsv, mask, joined, scale, found + split)
             found += split
