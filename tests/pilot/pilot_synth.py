@@ -8,6 +8,8 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from pilot.hsv import HsvBlobDetector
+
 Image = npt.NDArray[np.uint8]
 FloatImage = npt.NDArray[np.float64]
 
@@ -76,3 +78,9 @@ def matte_ball(bg: FloatImage, cx: float, cy: float, r: float, colour: tuple[flo
     ball = (ambient + (1.0 - ambient) * lit)[..., None] * np.array(colour, np.float64)
     alpha = np.clip(r + 0.5 - np.hypot(xx - cx, yy - cy), 0.0, 1.0)[..., None]
     return np.asarray(bg * (1.0 - alpha) + ball * alpha, np.float64)
+
+
+def best_hsv(img: Image) -> tuple[float, float, float] | None:
+    """The colour-ball detector's best candidate in ``img`` (centre and score), None without one."""
+    found = HsvBlobDetector().candidates(img)
+    return (found[0].cx, found[0].cy, found[0].score) if found else None

@@ -7,7 +7,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
-from pilot_synth import matte_ball
+from pilot_synth import best_hsv, matte_ball
 
 import pilot.hsv_split as hsv_split
 from pilot.hsv import HsvBlobDetector
@@ -41,11 +41,6 @@ def frame(balls: list[tuple[float, float]], r: float = R) -> np.ndarray:
     return np.asarray(np.clip(img + 0.5, 0, 255), np.uint8)
 
 
-def best(img: np.ndarray) -> tuple[float, float, float] | None:
-    found = HsvBlobDetector().candidates(img)
-    return (found[0].cx, found[0].cy, found[0].score) if found else None
-
-
 def test_the_frame_is_one_blob_in_hue() -> None:
     """The premise: the ball and the surface are both in the target's range, in one hue class."""
     img = frame([(CX, CY)])
@@ -57,12 +52,12 @@ def test_the_frame_is_one_blob_in_hue() -> None:
 
 def test_a_ball_on_a_surface_of_its_hue_is_split_off_by_saturation(monkeypatch: pytest.MonkeyPatch) -> None:
     img = frame([(CX, CY)])
-    found = best(img)
+    found = best_hsv(img)
     assert found is not None
     x, y, score = found
     assert score >= 0.6 and abs(x - CX) <= 2.0 and abs(y - CY) <= 2.0
     monkeypatch.setattr(hsv_split, "SAT_GAP", 256.0)  # no split by saturation: nothing at the ball
-    without = best(img)
+    without = best_hsv(img)
     assert without is None or without[2] < 0.6 or abs(without[0] - CX) > R
 
 
