@@ -327,8 +327,10 @@ class HsvBlobDetector(WindowRefiner):
                 fs = [half]
             else:
                 fs = self._refine(image, bounds, (x * scale, y * scale, bw * scale, bh * scale))
-                if not fs and scale > 1 and self.measure(small_hsv, mask, c, area, 0, 0, scale) is not None:
-                    unrefined.append((area, c, (x, y, bw, bh)))  # a ball in the search: joined in its window?
+                # a ball in the search, joined in its window? (``half``, stricter, says so where it measured one)
+                if not fs and scale > 1 and (half is not None
+                                             or self.measure(small_hsv, mask, c, area, 0, 0, scale) is not None):
+                    unrefined.append((area, c, (x, y, bw, bh)))
             found += [f for f in fs if is_new(f, found)]
         good = not splits or any(self.score(f, w) >= SPLIT_UNLESS for f in found)
         if (joined or unrefined) and not good:
