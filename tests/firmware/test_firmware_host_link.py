@@ -4,6 +4,7 @@ transmit buffer, random bytes, and the virtual drone over a pseudo-terminal (ste
 from __future__ import annotations
 
 import json
+import math
 import os
 import select
 import subprocess
@@ -175,7 +176,10 @@ def test_random_bytes_never_drive_an_output_outside_its_limits(chunks: list[byte
     script = fw.Script().arm()
     for i, chunk in enumerate(chunks):
         script.send(chunk).step(1 + (seed >> (i % 16)) % 300)
-    trace = script.step(dp.FAILSAFE_TIMEOUT_MS).run()
+    # the silence counts from the last byte off the wire: bytes sent faster than the line carries them (10 bits each)
+    # are still arriving, at most all of them
+    on_wire_ms = math.ceil(sum(len(c) for c in chunks) * 10_000 / dp.BAUD)
+    trace = script.step(on_wire_ms + dp.FAILSAFE_TIMEOUT_MS).run()
     since_boot = True  # the failsafe throttle is held from boot until the first sequence
     for c in trace.changes:
         since_boot = since_boot and c["state"] == "disarmed"
