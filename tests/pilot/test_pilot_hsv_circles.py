@@ -16,7 +16,7 @@ from pilot_synth import matte_ball
 import pilot.hsv as hsv
 import pilot.hsv_circles as hsv_circles
 from pilot.hsv_circles import Circle, _objects, centres, circles, inside_share
-from pilot.hsv_rim import COLOUR_FROM
+from pilot.hsv_rim import COLOUR_FROM, WHOLE
 
 Image = npt.NDArray[np.uint8]
 CX, CY = 160, 120
@@ -189,3 +189,21 @@ def test_a_circle_voted_in_colour_counts_from_the_colour_rims_size(monkeypatch: 
     wide = grey_twins(12)  # 24 px across, voted in colour
     monkeypatch.setattr(hsv_circles, "centres", lambda image, mask, r_max: [(70.0, 55.0, 12.0)] * (image.ndim - 2))
     assert len(circles(wide, mask, wide, 0, 0)) == 1
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_circle_s_rim_counts_once_for_its_shape_and_not_again_for_its_isolation(
+        seed: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A ball on a surface of its colour whose rim is an edge at 39 of 48 points, just over the circle look's bar
+    (``WHOLE``), is found at the acquisition threshold: its rim holds the shape score down a little, and its ring,
+    which the surface fills, is not read again as 1 - rim (0.53 before the twenty-sixth session)."""
+    img = on_surface(12, seed, 40)  # found by the circle look only (the first test)
+    real = hsv_circles.circles
+    scores = {}
+    for rim in (39 / 48, 1.0):
+        monkeypatch.setattr(hsv_circles, "circles", lambda *a, rim=rim: [c._replace(rim=rim) for c in real(*a)])
+        found = hsv.HsvBlobDetector().candidates(img)
+        assert found and math.hypot(found[0].cx - CX, found[0].cy - CY) <= 3.0
+        scores[rim] = found[0].score
+    assert WHOLE <= 39 / 48
+    assert 0.6 <= scores[39 / 48] < scores[1.0]
