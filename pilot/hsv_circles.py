@@ -181,14 +181,18 @@ def circle_features(roi: MatLike, hsv: MatLike, mask: MatLike, frame: MatLike, x
                     colour: ColourMask) -> list[Features]:
     """The circles of a window at (x0, y0) of ``frame`` (``roi``, its smoothed pixels, their HSV and mask), as
     the detector's features: the rim stands in for the arcs, the mask inside for the fill; the colour is the mask's
-    inside 0.9 radii (the rim's pixels blend). Isolation is the rim too, counted once: a circle here has a rim of
-    ``WHOLE`` all round, which walls it off from the surface of its colour it lies on, so its ring reads as empty.
-    Until the twenty-sixth session the ring read ``1 - rim`` as well, and a rim of 39 of 48 points scored 0.53
-    (0.81 for its shape, 0.65 again for its ring). On the five dev seed sets of bench/vision (not the report's):
-    13 balls more of 10,138 from 16 px, none fewer, the same false detections in their 3,750 empty and distractor
-    views; 2 more in 12,000 further dev negatives (a 15 px circle on an empty view, 0.56 -> 0.63, and a pink ball,
-    0.59 -> 0.60). Counting a whole rim as isolation in the rim look too found no ball more, and 4 false detections
-    more."""
+    inside 0.9 radii (the rim's pixels blend). From ``COLOUR_FROM`` across, isolation is the rim too, counted once: a
+    circle here has a rim of ``WHOLE`` all round, which walls it off from the surface of its colour it lies on, so
+    its ring reads as empty. A smaller circle's ring reads ``1 - rim`` (as every circle's did until the twenty-sixth
+    session, when a rim of 39 of 48 points scored 0.53: 0.81 for its shape, 0.65 again for its ring).
+
+    On the five dev seed sets of bench/vision (not the report's), counted once at any size: 13 balls more of 10,138
+    from 16 px, none fewer, the same false detections in their 3,750 empty and distractor views, 2 more in 12,000
+    further dev negatives; but on the report's validation photos, 4 empty views more (0.9 -> 1.1 %, over the goal),
+    circles of 15-18.6 px on the dahlia. From ``COLOUR_FROM`` (the size from which a colour rim, and a circle voted
+    for in colour, count): 12 balls more on the dev sets (the 13th was 17.4 px), none fewer, the same false
+    detections, 1 more in the 12,000 (a pink ball, 0.59 -> 0.60). Counting a whole rim as isolation in the rim look
+    too found no ball more, and 4 false detections more."""
     out = []
     found = circles(roi, mask, frame, x0, y0)
     if _objects(found) > 1:
@@ -198,5 +202,6 @@ def circle_features(roi: MatLike, hsv: MatLike, mask: MatLike, frame: MatLike, x
         cv2.circle(disc, (round(c.cx), round(c.cy)), max(1, int(0.9 * c.r)), 255, -1)
         mean = cv2.mean(hsv, mask=cv2.bitwise_and(disc, mask))
         out.append(Features(c.cx + x0, c.cy + y0, 2.0 * c.r, 0.0, 1.0, c.inside, 1.0, math.pi / 4.0, float(mean[1]),
-                            colour.hue_off(float(mean[0])), 0.0, 0.0, c.rim))
+                            colour.hue_off(float(mean[0])), 0.0 if 2.0 * c.r >= COLOUR_FROM else 1.0 - c.rim, 0.0,
+                            c.rim))
     return out

@@ -207,3 +207,16 @@ def test_a_circle_s_rim_counts_once_for_its_shape_and_not_again_for_its_isolatio
         scores[rim] = found[0].score
     assert WHOLE <= 39 / 48
     assert 0.6 <= scores[39 / 48] < scores[1.0]
+
+
+def test_a_circle_under_the_colour_rim_s_size_reads_its_ring_from_its_rim(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Under ``COLOUR_FROM`` across, a circle's ring stays ``1 - rim``: a dahlia's small cups have rims of 0.81-0.85
+    (the twenty-sixth session's report run on the validation photos)."""
+    img = on_surface(12, 0, 40)
+    mask = np.full(img.shape[:2], 255, np.uint8)
+    hsv_img = cv2.cvtColor(img, cv2.COLOR_BGR2HSV)
+    colour = hsv.HsvBlobDetector().colour
+    for r, ring in ((COLOUR_FROM / 2.0 - 1.0, 1.0 - 39 / 48), (COLOUR_FROM / 2.0, 0.0)):
+        monkeypatch.setattr(hsv_circles, "circles", lambda *a, r=r: [Circle(float(CX), float(CY), r, 1.0, 39 / 48)])
+        (f,) = hsv_circles.circle_features(img, hsv_img, mask, img, 0, 0, colour)
+        assert f.ring == pytest.approx(ring)
