@@ -246,11 +246,13 @@ class HsvBlobDetector(WindowRefiner):
         """``found`` with ``f`` (scoring ``s``), which replaces those at its place if it scores more than each and
         none of them is in a pattern of round things (the texture check, pilot/hsv_texture.py): measured again, a
         dot of a print may read smaller, with fewer peers in reach, and the place stays a pattern."""
-        same = [g for g in found if not is_new(f, [g])]
-        if any(s <= self.score(g, self._width) or textured(g.cx, g.cy, g.size, self.round_search, self.search_scale)
-               for g in same):
-            return found
-        return [g for g in found if is_new(f, [g])] + [f]
+        kept: list[Features] = []
+        for g in found:
+            if is_new(f, [g]):
+                kept.append(g)
+            elif s <= self.score(g, self._width) or textured(g.cx, g.cy, g.size, self.round_search, self.search_scale):
+                return found
+        return [*kept, f]
 
     def _enough(self, found: list[Features], width: int) -> bool:
         """Whether a look found something the pilot would act on (no further look then)."""
