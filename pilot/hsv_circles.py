@@ -68,16 +68,15 @@ class Grid(NamedTuple):
     thinned: int
 
 
-def centres(image: MatLike, mask: MatLike, r_max: float,
-            near: MatLike | None = None) -> list[tuple[float, float, float]]:
-    """The best circles (centre, radius; in the window) that the edges near the mask vote for: ``PER_BAND`` of
-    each octave of radii, the best supported first. ``image``: grey, or BGR (each pixel's strongest channel);
-    ``near``: the mask already grown by ``_NEAR`` (the grey and the colour votes share one)."""
+def centres(image: MatLike, near: MatLike, r_max: float) -> list[tuple[float, float, float]]:
+    """The best circles (centre, radius; in the window) that the edges in ``near`` (the window's mask grown by
+    ``_NEAR``: a rim lies just outside a blob's mask) vote for: ``PER_BAND`` of each octave of radii, the best
+    supported first. ``image``: grey, or BGR (each pixel's strongest channel)."""
     h, w = image.shape[:2]
     # the 3x3 Sobel once, for Canny and for the voting points' directions (its border replicated, as Canny's own)
     dx = cv2.Sobel(image, cv2.CV_16S, 1, 0, borderType=cv2.BORDER_REPLICATE)
     dy = cv2.Sobel(image, cv2.CV_16S, 0, 1, borderType=cv2.BORDER_REPLICATE)
-    edges = cv2.bitwise_and(cv2.Canny(dx, dy, *CANNY), near if near is not None else cv2.dilate(mask, _NEAR))
+    edges = cv2.bitwise_and(cv2.Canny(dx, dy, *CANNY), near)
     ys, xs = np.nonzero(edges)
     radii = RADII[: int(np.searchsorted(RADII, r_max, side="right"))]
     if len(xs) < 12 or not len(radii):
@@ -153,9 +152,9 @@ def circles(roi: MatLike, mask: MatLike, frame: MatLike, x0: int, y0: int) -> li
     mask) with the target's colour inside and a rim all round: the circle the rim support fits best (measured on
     the frame: unsmoothed, and not cut by the window's edge)."""
     r_max = max(mask.shape[:2]) / 2.0
-    near = cv2.dilate(mask, _NEAR)
-    voted = [(c, 0.0) for c in centres(cv2.cvtColor(roi, cv2.COLOR_BGR2GRAY), mask, r_max, near)]
-    voted += [(c, COLOUR_FROM) for c in centres(roi, mask, r_max, near)]  # in colour: counted from COLOUR_FROM across
+    near = cv2.dilate(mask, _NEAR)  # where the edges vote, in brightness and in colour
+    voted = [(c, 0.0) for c in centres(cv2.cvtColor(roi, cv2.COLOR_BGR2GRAY), near, r_max)]
+    voted += [(c, COLOUR_FROM) for c in centres(roi, near, r_max)]  # in colour: counted from COLOUR_FROM across
     out: list[Circle] = []
     for (cx, cy, r), least in voted:
         inside = inside_share(mask, cx, cy, r)

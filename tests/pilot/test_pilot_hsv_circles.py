@@ -179,7 +179,7 @@ def test_a_circle_voted_in_colour_counts_from_the_colour_rims_size(monkeypatch: 
     cv2.circle(small, (70, 55), 8, (10, 10, 90), -1, cv2.LINE_AA)  # 16 px across, a rim in brightness too
 
     def voted_in(ndim: int) -> object:
-        return lambda image, mask, r_max, near=None: [(70.0, 55.0, 8.0)] if image.ndim == ndim else []
+        return lambda image, near, r_max: [(70.0, 55.0, 8.0)] if image.ndim == ndim else []
 
     monkeypatch.setattr(hsv_circles, "centres", voted_in(2))
     assert len(circles(small, mask, small, 0, 0)) == 1
@@ -187,8 +187,7 @@ def test_a_circle_voted_in_colour_counts_from_the_colour_rims_size(monkeypatch: 
     assert circles(small, mask, small, 0, 0) == []
     assert COLOUR_FROM > 16.0
     wide = grey_twins(12)  # 24 px across, voted in colour
-    monkeypatch.setattr(hsv_circles, "centres",
-                        lambda image, mask, r_max, near=None: [(70.0, 55.0, 12.0)] * (image.ndim - 2))
+    monkeypatch.setattr(hsv_circles, "centres", lambda image, near, r_max: [(70.0, 55.0, 12.0)] * (image.ndim - 2))
     assert len(circles(wide, mask, wide, 0, 0)) == 1
 
 
