@@ -27,7 +27,7 @@ import numpy as np
 from cv2.typing import MatLike
 
 from .config import ArucoConfig, VisionConfig
-from .detection import Candidate, Detection, best_detection, frame_size, range_of
+from .detection import Candidate, Detection, best_detection, frame_size, malformed, range_of
 from .errors import ConfigError
 
 
@@ -94,7 +94,10 @@ class ArucoMarkerDetector:
         return sorted(found, key=lambda c: c.size, reverse=True)
 
     def candidates(self, image: MatLike) -> list[Candidate]:
-        grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
+        """None in a frame that is no 8-bit, 3-channel image of a usable size (``detection.malformed`` names it)."""
+        if malformed(image) is not None:
+            return []
+        grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
         width = frame_size(image)[0]
         found = self._markers(grey, 1.0, width)
         if not found:

@@ -82,7 +82,8 @@ class Detector(Protocol):
 
 
 class CandidateSource(Protocol):
-    """A single-frame detector: every candidate in the frame, best first."""
+    """A single-frame detector: every candidate in the frame, best first; none in a frame ``malformed`` names (not
+    an OpenCV error)."""
 
     name: str
 

@@ -98,7 +98,7 @@ import numpy as np
 from cv2.typing import MatLike
 
 from .config import HsvConfig, VisionConfig
-from .detection import Candidate, Detection, best_detection, frame_size
+from .detection import Candidate, Detection, best_detection, frame_size, malformed
 from .hsv_circles import circle_features
 from .hsv_colour import Bounds, darker, grown
 from .hsv_hollow import hollow
@@ -357,7 +357,8 @@ class HsvBlobDetector(WindowRefiner):
         return found
 
     def candidates(self, image: MatLike) -> list[Candidate]:
-        return self._ranked(self.features(image), frame_size(image)[0])
+        """None in a frame that is no 8-bit, 3-channel image of a usable size (``detection.malformed`` names it)."""
+        return [] if malformed(image) is not None else self._ranked(self.features(image), frame_size(image)[0])
 
     def _ranked(self, found: list[Features], width: int) -> list[Candidate]:
         """The blobs scoring above zero and at least ``min_score``, as candidates, best first."""
@@ -369,6 +370,8 @@ class HsvBlobDetector(WindowRefiner):
         """Where a tracked ball should be and the frame's look found nothing: that window refined with the V
         bound ``NEAR_GAIN`` times as high. The frame's bound follows its brightest part: a ball against a
         bright window darkens under it as the window fills more of the frame, while still plainly a red disc."""
+        if malformed(image) is not None:
+            return []
         w, h = frame_size(image)
         self._width = w
         half = size / 2.0 + NEAR_MARGIN * w
@@ -389,5 +392,7 @@ class HsvBlobDetector(WindowRefiner):
         the ball across: something in front of a centred ball hides its middle while the circle fitted to its
         rim stays centred, and it reaches the window's edge a frame or two before the middle. The V bound is the
         closer look's (``NEAR_GAIN``): the ball it found in shade is in shade at its middle too."""
+        if malformed(image) is not None:
+            return False
         r = max(2, min(round(AIM_SPAN * size / 2.0), image.shape[0] // 4))
         return self.colour.centre_holds(image, r, NEAR_GAIN, AIM_SHARE)

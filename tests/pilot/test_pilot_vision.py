@@ -36,22 +36,33 @@ def test_bad_frames_are_named_and_never_found(image: object, status: FrameStatus
     assert det.status is status and not det.found
 
 
-@pytest.mark.parametrize(
-    "image,status",
-    [
-        (np.zeros((240, 320), np.uint8) + 100, FrameStatus.WRONG_SHAPE),
-        (np.zeros((240, 320, 4), np.uint8) + 100, FrameStatus.WRONG_SHAPE),
-        (np.zeros((8, 8, 3), np.uint8) + 100, FrameStatus.WRONG_SHAPE),
-        (np.zeros((0, 0, 3), np.uint8), FrameStatus.WRONG_SHAPE),
-        (np.zeros((240, 320, 3), np.float32) + 100, FrameStatus.WRONG_TYPE),
-        (None, FrameStatus.WRONG_TYPE),
-    ],
-)
+MALFORMED = [
+    (np.zeros((240, 320), np.uint8) + 100, FrameStatus.WRONG_SHAPE),
+    (np.zeros((240, 320, 4), np.uint8) + 100, FrameStatus.WRONG_SHAPE),
+    (np.zeros((8, 8, 3), np.uint8) + 100, FrameStatus.WRONG_SHAPE),
+    (np.zeros((1, 640, 3), np.uint8) + 100, FrameStatus.WRONG_SHAPE),  # wide enough for the half-size search
+    (np.zeros((0, 0, 3), np.uint8), FrameStatus.WRONG_SHAPE),
+    (np.zeros((240, 320, 3), np.float32) + 100, FrameStatus.WRONG_TYPE),
+    (None, FrameStatus.WRONG_TYPE),
+]
+
+
+@pytest.mark.parametrize("image,status", MALFORMED)
 def test_single_frame_detectors_name_malformed_frames(image: object, status: FrameStatus) -> None:
     """The single-frame ``detect`` (no tracking) answers a malformed frame with its status, not an OpenCV error."""
     for det in (HsvBlobDetector(), ArucoMarkerDetector()):
         out = det.detect(image)  # type: ignore[arg-type]
         assert out.status is status and not out.found, det.name
+
+
+@pytest.mark.parametrize("image,status", MALFORMED)
+def test_candidate_sources_find_nothing_in_malformed_frames(image: object, status: FrameStatus) -> None:
+    """The lower-level calls a caller may make without ``detect``: no candidate and no OpenCV error (a 1-pixel-tall
+    frame 640 wide once reached the half-size search and failed in its resize); the aim point does not hold."""
+    for det in (HsvBlobDetector(), ArucoMarkerDetector()):
+        assert det.candidates(image) == [], (det.name, status)  # type: ignore[arg-type]
+        assert det.candidates_near(image, 4.0, 4.0, 6.0) == [], det.name  # type: ignore[arg-type]
+        assert not det.aim_on_target(image, 6.0), det.name  # type: ignore[arg-type]
 
 
 def test_frozen_camera_and_size_change() -> None:
