@@ -127,6 +127,14 @@ def test_calibration_roi_outside_the_image() -> None:
         hsv_ranges_from_sample(synth.background(320, 240), roi=(300, 200, 50, 50))
 
 
+@pytest.mark.parametrize("sample", [np.full((240, 320), 128, np.uint8), np.zeros((240, 320, 4), np.uint8),
+                                    np.zeros((240, 320, 3), np.float32), None])
+def test_calibration_names_a_sample_that_is_no_colour_image(sample: object) -> None:
+    """Grey, BGRA, float or no image: named as such, not an OpenCV error or "0 pixels are coloured"."""
+    with pytest.raises(ConfigError, match="8-bit, 3-channel"):
+        hsv_ranges_from_sample(sample)  # type: ignore[arg-type]
+
+
 # -- frame sources -------------------------------------------------------------------------------------
 
 
