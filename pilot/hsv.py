@@ -94,7 +94,6 @@ from __future__ import annotations
 import math
 
 import cv2
-import numpy as np
 from cv2.typing import MatLike
 
 from .config import HsvConfig, VisionConfig
@@ -107,10 +106,10 @@ from .hsv_measure import HALF_DECIDES
 from .hsv_noise import smoothed
 from .hsv_refine import EDGE_BLOBS, SEARCH_FILL, SPLIT_BLOBS, Box, WindowRefiner, is_new
 from .hsv_score import SIZE, Features, arc_score
+from .hsv_search import SEARCH_MIN_WIDTH, SearchFrames
 from .hsv_texture import SearchBlob, textured
 
 MAX_CANDIDATES = 4  # the largest search blobs refined; smaller ones cannot be the nearest target
-SEARCH_MIN_WIDTH = 320  # frames at least this wide are searched at half resolution
 HALF_MEASURE = 48  # px across (full resolution): a search blob this wide is measured at half resolution
 SPLIT_FILL = 0.75  # a search blob filling less of its box's disc may be a ball joined to something
 HALF_TRY = 24  # px across: a smaller search blob is only refined; from this, first measured at half
@@ -125,7 +124,6 @@ RIM_LOOKS = 6  # blobs held down by their arcs or ring measured again with their
 CIRCLE_BLOBS = 2  # the largest search blobs the circle look searches
 NEAR_GAIN = 0.4  # a tracked ball's closer look: the V bound this much lower (under the second look's reach)...
 NEAR_MARGIN = 0.1  # ...in a window this share of the frame's width wider than the ball on each side
-SEARCH_BUFFERS = 6  # search buffer pairs kept at most (three a frame size)
 AIM_SPAN, AIM_SHARE = 0.35, 0.8  # the aim point's window (of the ball's diameter), and its share of target colour
 
 
@@ -144,7 +142,7 @@ class HsvBlobDetector(WindowRefiner):
         self._blobs: list[SearchBlob] = []  # the first look's search blobs, where the circle look searches
         self._tried: set[tuple[float, Box]] = set()  # the first look's blobs split or cut by edges (area, box)
         self._plain_ok: dict[int, Features] = {}  # this frame's blobs found plain inside (by id, kept alive)
-        self._buffers: dict[tuple[int, int, int], tuple[MatLike, ...]] = {}  # the search's (width, height, slot)
+        self._frames = SearchFrames(self.colour)  # the search's frame, HSV and mask, in buffers kept
 
     @property
     def single_range(self) -> bool:
@@ -164,7 +162,7 @@ class HsvBlobDetector(WindowRefiner):
         self._windows.clear()
         self._plain_ok.clear()
         scale = 2 if w >= SEARCH_MIN_WIDTH else 1
-        small, bounds, small_hsv = self._search(image, scale)
+        small, bounds, small_hsv = self._frames.search(image, scale)
         found = self._plain(image, bounds, self._look(image, bounds, small, small_hsv, scale))
         if self._enough(found, w):
             return found
@@ -174,7 +172,7 @@ class HsvBlobDetector(WindowRefiner):
             if self._enough(found, w):
                 return found
         if (smooth := smoothed(image)) is not None:  # a noisy frame (pilot/hsv_noise.py)
-            s_small, s_bounds, s_hsv = self._search(smooth, scale, look=1)
+            s_small, s_bounds, s_hsv = self._frames.search(smooth, scale, look=1)
             found = self._plain(image, bounds, self._again(smooth, s_bounds, s_small, s_hsv, scale, found,
                                                            splits=True))
             if self._enough(found, w):
@@ -201,30 +199,6 @@ class HsvBlobDetector(WindowRefiner):
                 self._plain_ok[id(f)] = f
             out.append(f)
         return out
-
-    def _search(self, image: MatLike, scale: int, look: int = 0) -> tuple[MatLike, Bounds, MatLike]:
-        """The search's frame (``scale`` times smaller), its bounds for the frame's exposure, and its HSV; ``look``: 0
-        for the frame, 1 for its smoothed copy, which must not overwrite the first look's (a rim look measures its
-        blobs again)."""
-        w, h = frame_size(image)
-        size = (w // scale, h // scale)
-        buffers = self._reused(size, look, 3)
-        small = cv2.resize(image, size, dst=buffers[0], interpolation=cv2.INTER_AREA) if scale > 1 else image
-        bounds = self.colour.bounds_for(small)  # the exposure read where the resize has just been: in cache
-        return small, bounds, cv2.cvtColor(small, self.colour.code, dst=buffers[1])
-
-    def _reused(self, size: tuple[int, int], slot: int, channels: int) -> tuple[MatLike, ...]:
-        """Two buffers of ``size`` kept from frame to frame, for the search's ``slot`` (0 and 1: a frame and its HSV,
-        see ``_search``; 2: the first look's mask before and after its opening). Written into, not allocated, they
-        stay in the caches: 3-4 % of a frame at 320x240."""
-        key = (*size, slot)
-        buffers = self._buffers.get(key)
-        if buffers is None:
-            if len(self._buffers) >= SEARCH_BUFFERS:  # frame sizes changing: keep the newest only
-                self._buffers.clear()
-            shape = (size[1], size[0], channels) if channels > 1 else (size[1], size[0])
-            buffers = self._buffers[key] = tuple(np.empty(shape, np.uint8) for _ in range(2))
-        return buffers
 
     def _again(self, image: MatLike, bounds: Bounds, small: MatLike, small_hsv: MatLike, scale: int,
                found: list[Features], splits: bool, same_frame: bool = False) -> list[Features]:
@@ -289,7 +263,7 @@ class HsvBlobDetector(WindowRefiner):
         smaller, and its HSV); ``first``: the frame's first look, whose blobs the later looks use; ``tried``: blobs
         (area, box) split or cut already, not split or cut again (the first look's, as they are in a grown mask)."""
         w = frame_size(image)[0]
-        out: tuple[MatLike | None, ...] = self._reused(frame_size(small_hsv), 2, 1) if first else (None, None)
+        out: tuple[MatLike | None, ...] = self._frames.mask_buffers(frame_size(small_hsv)) if first else (None, None)
         mask = self.colour.in_range(small_hsv, bounds, out[0])
         if self.colour.kernel is not None:
             mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, self.colour.kernel, dst=out[1])
