@@ -94,7 +94,7 @@ class ArucoMarkerDetector:
         return sorted(found, key=lambda c: c.size, reverse=True)
 
     def candidates(self, image: MatLike) -> list[Candidate]:
-        """None in a frame that is no 8-bit, 3-channel image of a usable size (``detection.malformed`` names it)."""
+        """Every candidate, best first; an empty list for a frame ``detection.malformed`` names (no OpenCV error)."""
         if malformed(image) is not None:
             return []
         grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)

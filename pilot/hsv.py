@@ -331,7 +331,7 @@ class HsvBlobDetector(WindowRefiner):
         return found
 
     def candidates(self, image: MatLike) -> list[Candidate]:
-        """None in a frame that is no 8-bit, 3-channel image of a usable size (``detection.malformed`` names it)."""
+        """Every candidate, best first; an empty list for a frame ``detection.malformed`` names (no OpenCV error)."""
         return [] if malformed(image) is not None else self._ranked(self.features(image), frame_size(image)[0])
 
     def _ranked(self, found: list[Features], width: int) -> list[Candidate]:
