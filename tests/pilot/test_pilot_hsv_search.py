@@ -7,6 +7,7 @@ import dataclasses
 
 import cv2
 import numpy as np
+import pilot_synth as synth
 
 from pilot.config import HsvConfig
 from pilot.hsv import HsvBlobDetector
@@ -15,9 +16,7 @@ from pilot.hsv_search import BUFFERS_KEPT, SEARCH_MIN_WIDTH, SearchFrames
 
 
 def ball_frame(w: int, h: int, cx: int, cy: int, r: int) -> np.ndarray:
-    img = np.full((h, w, 3), 110, np.uint8)
-    cv2.circle(img, (cx, cy), r, (40, 40, 210), -1, cv2.LINE_AA)
-    return img
+    return synth.red_disc(synth.background(w, h), cx, cy, r)
 
 
 def test_a_wide_frame_is_searched_at_half_resolution_in_kept_buffers() -> None:
