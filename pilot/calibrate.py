@@ -22,6 +22,7 @@ from cv2.typing import MatLike
 
 from . import config as config_mod
 from .config import HsvConfig, HsvRange, PilotConfig
+from .detection import colour_image
 from .errors import ConfigError
 from .hsv import HsvBlobDetector
 
@@ -45,7 +46,7 @@ def _check_roi(image: MatLike, roi: Roi) -> None:
 
 def hsv_ranges_from_sample(image: MatLike, roi: Roi | None = None) -> tuple[HsvRange, ...]:
     """Ranges around the ROI's hue mode, as wide as the hue spread around it (3 sigma + 2, 3..15 units)."""
-    if not isinstance(image, np.ndarray) or image.dtype != np.uint8 or image.ndim != 3 or image.shape[2] != 3:
+    if not colour_image(image):
         got = f"{image.dtype} {image.shape}" if isinstance(image, np.ndarray) else type(image).__name__
         raise ConfigError(f"calibration: the sample must be an 8-bit, 3-channel (BGR) image, not {got}")
     x, y, w, h = roi if roi is not None else central_roi(image)

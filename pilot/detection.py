@@ -25,12 +25,17 @@ class FrameStatus(enum.Enum):
 MIN_WIDTH, MIN_HEIGHT = 32, 24  # a smaller frame has too few pixels to show any target's shape
 
 
+def colour_image(image: object) -> bool:
+    """Whether ``image`` is an 8-bit, 3-channel (BGR) image, of any size."""
+    return isinstance(image, np.ndarray) and image.dtype == np.uint8 and image.ndim == 3 and image.shape[2] == 3
+
+
 def malformed(image: object) -> FrameStatus | None:
     """WRONG_TYPE or WRONG_SHAPE when ``image`` is no frame a detector can look at (an 8-bit, 3-channel image at
     least MIN_WIDTH x MIN_HEIGHT), else None."""
     if not isinstance(image, np.ndarray) or image.dtype != np.uint8:
         return FrameStatus.WRONG_TYPE
-    if image.ndim != 3 or image.shape[2] != 3 or image.shape[1] < MIN_WIDTH or image.shape[0] < MIN_HEIGHT:
+    if not colour_image(image) or image.shape[1] < MIN_WIDTH or image.shape[0] < MIN_HEIGHT:
         return FrameStatus.WRONG_SHAPE
     return None
 
