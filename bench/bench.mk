@@ -12,6 +12,10 @@
 #                         held-out and validation photos, time vs
 #                         the cvtColor+inRange floor; 400 views per condition, about 6 minutes on 2 cores;
 #                         writes bench/vision/RESULTS.md (BENCH_VISION_FLAGS=--quick for a smoke run)
+#   make bench-vision-dev the colour-ball detector on bench/vision's dev seed sets (tuning and validation photos, never
+#                         the report's seeds), every candidate recorded in build/vision-dev/$(VISION_DEV_RECORD)
+#                         (default: current), about 3 minutes on 2 cores; compare two records with
+#                         bench/vision/vision_dev.py compare A B (how bench/vision/HISTORY.md measures a change)
 #   make bench-tools      the standalone codec wheel's size and import time vs json; the live view's frame
 #                         latency and the pilot loop's rate with and without a viewer; writes bench/tools/RESULTS.md
 #   make bench-flight     the closed-loop campaign in the MuJoCo simulator: seeded flights per detector across
@@ -29,9 +33,11 @@ BENCH_PROTOCOL_BUILD ?= build/bench/protocol
 BENCH_PROTOCOL_FLAGS ?=
 
 BENCH_VISION_FLAGS ?=
+VISION_DEV_RECORD ?= current
 BENCH_FLIGHT_FLAGS ?=
 
-.PHONY: bench bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-ide bench-tools bench-flight
+.PHONY: bench bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-vision-dev bench-ide bench-tools \
+        bench-flight
 
 # Run benchmarks one at a time (not with make -j): they time each other otherwise.
 bench: bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-ide bench-rust-c bench-tools \
@@ -42,6 +48,9 @@ bench-flight: deps firmware-host
 
 bench-vision: deps
 	PYTHONPATH=.:bench/vision $(PY) bench/vision/run.py $(BENCH_VISION_FLAGS)
+
+bench-vision-dev: deps
+	PYTHONPATH=.:bench/vision $(PY) bench/vision/vision_dev.py record $(VISION_DEV_RECORD)
 
 bench-protocol: deps
 	$(PY) -m bench.protocol.run --build $(BENCH_PROTOCOL_BUILD) $(BENCH_PROTOCOL_FLAGS)
