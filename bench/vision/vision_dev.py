@@ -113,7 +113,7 @@ def correct(v: View, threshold: float) -> bool:
     if v.kind != "target" or not v.candidates or v.candidates[0][3] < threshold:
         return False
     cx, cy = v.candidates[0][:2]
-    return bool(np.hypot(cx - v.cx, cy - v.cy) <= max(3.0, 0.3 * v.size))
+    return bool(np.hypot(cx - v.cx, cy - v.cy) <= ve.tolerance(v.size))
 
 
 def detected(v: View, threshold: float) -> bool:

@@ -60,15 +60,16 @@ def run(candidates: Candidates, views: list[vi.Sample]) -> list[Record]:
 
 
 def _at(c: Candidate, s: vi.Sample) -> bool:
-    return math.hypot(c.cx - s.cx, c.cy - s.cy) <= _tolerance(s.size)
+    return math.hypot(c.cx - s.cx, c.cy - s.cy) <= tolerance(s.size)
 
 
-def _tolerance(size: float) -> float:
+def tolerance(size: float) -> float:
+    """How far from the truth a candidate may lie and still be at the target (pixels)."""
     return max(3.0, 0.3 * size)
 
 
 def correct(r: Record, threshold: float) -> bool:
-    return r.found and r.confidence >= threshold and r.error <= _tolerance(r.size)
+    return r.found and r.confidence >= threshold and r.error <= tolerance(r.size)
 
 
 def detected(r: Record, threshold: float) -> bool:
