@@ -88,10 +88,22 @@ _BY_CODES: Final[Mapping[tuple[str, str], CommandSpec]] = {
 CATEGORY_CODES: Final = "mtsli"
 
 _new = tuple.__new__
-# What valid() needs of each command, by the frame's first two bytes, in one tuple (fewer attribute lookups).
-_FIELDS: Final[Mapping[bytes, tuple[Category, Direction, CommandName, int, int]]] = {
-    s.prefix: (s.category, s.direction, s.name, s.minimum, s.maximum) for s in COMMANDS.values()
-}
+_Fields = tuple[Category, Direction, CommandName, int, int]
+
+
+def _fields_table() -> tuple[tuple[_Fields | None, ...], ...]:
+    """What the hot path needs of each command, in one tuple, by the frame's first two bytes as numbers: two tuple
+    indexings, where a dict keyed by the first two bytes cost a slice and its hash (about 300 instructions a frame
+    in bench/protocol/python_instructions.py)."""
+    rows: dict[int, list[_Fields | None]] = {}
+    for s in COMMANDS.values():
+        rows.setdefault(s.prefix[0], [None] * 256)[s.prefix[1]] = (s.category, s.direction, s.name, s.minimum,
+                                                                    s.maximum)
+    nothing: tuple[_Fields | None, ...] = (None,) * 256
+    return tuple(tuple(rows[c]) if c in rows else nothing for c in range(256))
+
+
+_FIELDS: Final = _fields_table()
 # Decoded frames, by wire frame: Command is immutable, and a pilot sends few distinct frames.
 DECODED: Final[dict[bytes, Command]] = {}
 _DECODED_MAX: Final = 1024
@@ -99,21 +111,19 @@ _DECODED_MAX: Final = 1024
 
 def valid(frame: bytes) -> Command | None:
     """The command of a valid wire frame (exactly WIRE_LENGTH bytes), or None: the hot path, no exceptions."""
-    fields = _FIELDS.get(frame[:2])
-    if fields is None:
-        return None
-    digits = frame[2:FRAME_LENGTH]
-    if not digits.isdigit():  # bytes.isdigit() accepts ASCII digits only
-        return None
-    value = int(digits)
-    category, direction, name, minimum, maximum = fields
-    if value < minimum or value > maximum:
-        return None
-    command: Command = _new(Command, (category, direction, value, name))
-    if len(DECODED) >= _DECODED_MAX:
-        DECODED.clear()
-    DECODED[frame] = command
-    return command
+    fields = _FIELDS[frame[0]][frame[1]]
+    if fields is not None:
+        digits = frame[2:FRAME_LENGTH]
+        if digits.isdigit():  # bytes.isdigit() accepts ASCII digits only
+            value = int(digits)
+            category, direction, name, minimum, maximum = fields
+            if minimum <= value <= maximum:
+                command = _new(Command, (category, direction, value, name))
+                if len(DECODED) >= _DECODED_MAX:
+                    DECODED.clear()
+                DECODED[frame] = command
+                return command
+    return None
 
 
 def problem(data: bytes, start: int, length: int) -> tuple[ErrorKind, int] | None:
@@ -175,10 +185,19 @@ def decode(frame: BytesLike) -> Command:
     command = DECODED.get(frame)  # bytes by now
     if command is not None:
         return command
-    if len(frame) == WIRE_LENGTH:
-        command = valid(frame)
-        if command is not None:
-            return command
+    if len(frame) == WIRE_LENGTH:  # valid(), written out here: the call cost more than its body's checks
+        fields = _FIELDS[frame[0]][frame[1]]
+        if fields is not None:
+            digits = frame[2:FRAME_LENGTH]
+            if digits.isdigit():  # bytes.isdigit() accepts ASCII digits only
+                value = int(digits)
+                category, direction, name, minimum, maximum = fields
+                if minimum <= value <= maximum:
+                    command = _new(Command, (category, direction, value, name))
+                    if len(DECODED) >= _DECODED_MAX:
+                        DECODED.clear()
+                    DECODED[frame] = command
+                    return command
     elif len(frame) < WIRE_LENGTH:
         raise TooShortError(f"frame has {len(frame)} bytes, expected {WIRE_LENGTH}", len(frame))
     else:
