@@ -17,7 +17,8 @@ Record the code as it is, change it, record again and compare (``make bench-visi
     PYTHONPATH=.:bench/vision .venv/bin/python bench/vision/vision_dev.py compare before after
 
 A record keeps every candidate of every view, in build/vision-dev/<name>/<set>.json. Recording takes about 3 minutes
-on 2 cores.
+on 2 cores; ``record NAME --sets tun val ...`` records some sets only, and ``compare`` reads the sets both records
+hold.
 """
 
 from __future__ import annotations
@@ -151,48 +152,63 @@ def _counted(groups: list[str]) -> str:
     return ", ".join(f"{g} {groups.count(g)}" for g in sorted(set(groups))) or "none"
 
 
-def report(before: str, after: str, threshold: float) -> list[str]:
+def recorded(run: str, out: Path = OUT) -> list[str]:
+    """The dev sets a record holds, in the order of ``sets()``."""
+    return [name for name in sets() if (out / run / f"{name}.json").is_file()]
+
+
+def report(before: str, after: str, threshold: float, out: Path = OUT) -> list[str]:
+    """Set by set, then in total: the balls gained and lost, and the false detections, over the sets both records
+    hold."""
+    both = [name for name in recorded(before, out) if name in recorded(after, out)]
+    if not both:
+        raise SystemExit(f"the records {before!r} and {after!r} hold no dev set in common (vision_dev.py record)")
     lines = []
-    totals = {"balls": [0, 0, 0, 0], "false": [0, 0], "negatives": [0, 0]}  # gained, lost, before, after
-    for name in sets():
-        d = compare(load(before, name), load(after, name), threshold)
-        line = f"{name:5s} false detections {d.false[0]} -> {d.false[1]}"
+    gained = lost = negatives = 0
+    false = [0, 0]  # on the target sets, before and after
+    further = [0, 0]  # of the further negatives
+    for name in both:
+        a = load(before, name, out)
+        d = compare(a, load(after, name, out), threshold)
+        line = f"false detections {d.false[0]} -> {d.false[1]}; records differing {d.differ}"
         if name in TARGET_SETS:
-            line = f"{name:5s} balls {d.balls[0]} -> {d.balls[1]} of {d.balls[2]} (+{len(d.gained)} -{len(d.lost)}); " \
-                   + line[6:]
-            totals["balls"][0] += len(d.gained)
-            totals["balls"][1] += len(d.lost)
-            totals["false"][0] += d.false[0]
-            totals["false"][1] += d.false[1]
+            line = f"balls {d.balls[0]} -> {d.balls[1]} of {d.balls[2]} (+{len(d.gained)} -{len(d.lost)}); {line}"
+            gained, lost = gained + len(d.gained), lost + len(d.lost)
+            false = [false[0] + d.false[0], false[1] + d.false[1]]
         else:
-            totals["negatives"][0] += d.false[0]
-            totals["negatives"][1] += d.false[1]
-        lines.append(f"{line}; records differing {d.differ}")
+            negatives += len(a)
+            further = [further[0] + d.false[0], further[1] + d.false[1]]
+        lines.append(f"{name:5s} {line}")
         if d.gained or d.lost:
             lines.append(f"      balls gained: {_counted(d.gained)}; lost: {_counted(d.lost)}")
         if d.new_false or d.gone_false:
             lines.append(f"      false detections new: {_counted(d.new_false)}; gone: {_counted(d.gone_false)}")
-    b, f, n = totals["balls"], totals["false"], totals["negatives"]
-    lines.append(f"total: balls +{b[0]} -{b[1]}; false detections {f[0]} -> {f[1]} on the target sets, "
-                 f"{n[0]} -> {n[1]} of the 12,000 further negatives")
+    lines.append(f"total: balls +{gained} -{lost}; false detections {false[0]} -> {false[1]} on the target sets, "
+                 f"{further[0]} -> {further[1]} of the {negatives:,} further negatives")
+    if missing := [name for name in sets() if name not in both]:
+        lines.append(f"not in both records: {', '.join(missing)}")
     return lines
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
-    rec = sub.add_parser("record", help="record every dev set with the detector as it is")
+    rec = sub.add_parser("record", help="record the dev sets with the detector as it is")
     rec.add_argument("name", help="the record's name (a directory of build/vision-dev)")
+    rec.add_argument("--sets", nargs="+", choices=sets(), default=sets(),
+                     help="only these sets (the target sets alone take about half the time)")
     cmp = sub.add_parser("compare", help="balls gained and lost, false detections, between two records")
     for arg in ("before", "after"):
         cmp.add_argument(arg)
+    cmp.add_argument("--threshold", type=float, default=ControllerConfig().acquire_confidence,
+                     help="the score that counts as a detection (default: the controller's acquire_confidence)")
     args = ap.parse_args(argv)
     if args.command == "record":
         with Pool(2) as pool:
-            for name in pool.imap_unordered(_record_set, [(args.name, n) for n in sets()]):
+            for name in pool.imap_unordered(_record_set, [(args.name, n) for n in args.sets]):
                 print(f"recorded {name}", flush=True)
         return 0
-    print("\n".join(report(args.before, args.after, ControllerConfig().acquire_confidence)))
+    print("\n".join(report(args.before, args.after, args.threshold)))
     return 0
 
 

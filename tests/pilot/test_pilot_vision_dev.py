@@ -58,3 +58,21 @@ def test_a_small_record_round_trips_and_compares_equal(tmp_path: Path) -> None:
     assert d.differ == 0 and not d.gained and not d.lost and d.false[0] == d.false[1]
     with pytest.raises(SystemExit, match="no such record"):
         dev.load("c", "tun", tmp_path)
+
+
+def test_the_report_sums_the_sets_both_records_hold(tmp_path: Path) -> None:
+    dev.save([_ball(0.5), _ball(0.9, group="dim")], "a", "tun", tmp_path)
+    dev.save([_ball(0.7), _ball(0.3, group="dim")], "b", "tun", tmp_path)
+    for run, score in (("a", 0.0), ("b", 0.8)):
+        dev.save([_empty(score, "pink"), _empty(0.0)], run, "dt", tmp_path)
+    dev.save([_empty(0.0)], "a", "dv", tmp_path)  # in one record only
+    lines = dev.report("a", "b", 0.6, tmp_path)
+    assert lines[0].startswith("tun   balls 1 -> 1 of 2 (+1 -1)")
+    assert lines[1] == "      balls gained: jpeg 1; lost: dim 1"
+    assert lines[2].startswith("dt    false detections 0 -> 1; records differing 1")
+    assert lines[3] == "      false detections new: pink 1; gone: none"
+    assert lines[-2] == ("total: balls +1 -1; false detections 0 -> 0 on the target sets, 0 -> 1 of the 2 further "
+                         "negatives")
+    assert lines[-1].startswith("not in both records: val, tun2, tunx, valx, dv,")
+    with pytest.raises(SystemExit, match="no dev set in common"):
+        dev.report("a", "c", 0.6, tmp_path)
