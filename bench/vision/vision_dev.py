@@ -160,7 +160,8 @@ def recorded(run: str, out: Path = OUT) -> list[str]:
 def report(before: str, after: str, threshold: float, out: Path = OUT) -> list[str]:
     """Set by set, then in total: the balls gained and lost, and the false detections, over the sets both records
     hold."""
-    both = [name for name in recorded(before, out) if name in recorded(after, out)]
+    held = recorded(after, out)
+    both = [name for name in recorded(before, out) if name in held]
     if not both:
         raise SystemExit(f"the records {before!r} and {after!r} hold no dev set in common (vision_dev.py record)")
     lines = []
