@@ -83,6 +83,30 @@ def test_any_bytes_and_any_clock(data: bytes, now: float) -> None:
         dp.StreamDecoder().feed(data, now)
 
 
+# Pauses near the timeout, as whole milliseconds plus a fraction near the rounding's halfway point.
+_TIMEOUT = dp.INTER_BYTE_TIMEOUT_MS
+pauses = st.tuples(st.integers(_TIMEOUT - 2, _TIMEOUT + 2) | st.integers(0, 3 * _TIMEOUT),
+                   st.sampled_from([0.0, 0.4999, 0.5, 0.5001, -0.4999, -0.5, -0.5001]) | st.floats(-1.0, 1.0))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.sampled_from([0.0, 1.0, 86_400.0, 1e6, 1e9]), st.lists(st.tuples(pauses, st.integers(1, 3)), max_size=12),
+       st.sampled_from([dp.move_up(1700), b"zmf16", dp.move_up(1700)[:4]]))
+def test_only_the_whole_milliseconds_of_a_pause_count(start: float, steps: list[tuple[tuple[int, float], int]],
+                                                     first: bytes) -> None:
+    """The decoder rounds a pause only near the timeout: it must act as one given the times rounded first."""
+    stream = first + b"".join(dp.move_up(1700) for _ in steps)
+    raw, rounded = dp.StreamDecoder(), dp.StreamDecoder()
+    at_ms, i = start * 1000.0, 0
+    out: tuple[list[dp.Command], list[dp.Command]] = ([], [])
+    for (whole, part), size in [((0, 0.0), 2), *steps]:
+        at_ms += whole + part
+        chunk, i = stream[i:i + size], i + size
+        out[0].extend(raw.feed(chunk, at_ms / 1000.0))
+        out[1].extend(rounded.feed(chunk, round(at_ms) / 1000.0))
+    assert out[0] == out[1] and dict(raw.errors) == dict(rounded.errors) and raw.pending == rounded.pending
+
+
 def test_one_byte_at_a_time_finds_what_one_chunk_finds() -> None:
     stream = b"".join(dp.command_frame(name) for name in dp.CommandName if dp.COMMANDS[name].default is not None)
     stream = b"zz" + stream[:7] + b"q" + stream + b"\xffmf16"
@@ -112,6 +136,10 @@ valid = [bytes.fromhex(v["frame_hex"]) for v in vectors["vectors"] if v["ok"]]
 decoder = p.StreamDecoder()
 found = decoder.feed(bytes([255]).join(valid), 1.0)
 assert found == [p.decode(f) for f in valid] and decoder.errors[p.ErrorKind.BAD_CATEGORY] == len(valid) - 1
+stream = b"zz" + valid[0][:5] + b"q" + bytes([255]).join(valid) + valid[0][:7]
+whole, single = p.StreamDecoder(), p.StreamDecoder()
+assert whole.feed(stream, 1.0) == [c for i in range(len(stream)) for c in single.feed(stream[i:i + 1], 1.0)]
+assert dict(whole.errors) == dict(single.errors) and whole.pending == single.pending == valid[0][:7]
 line = p.accepted_line(p.decode(p.move_up(1700)), p.DroneState.MOVING, True)
 assert line.startswith(b"Amu m1*") and p.parse_reply(line).laser is True
 try:

@@ -25,6 +25,12 @@ _FRAME_SHAPE = re.compile(
 # completes the wire frame.
 _DIGITS_END = FRAME_LENGTH if WIRE_LENGTH > FRAME_LENGTH else FRAME_LENGTH - 1
 _LAST = WIRE_LENGTH - 1
+# The one-byte path's tables, of one-byte bytes objects: CPython shares those, so each one's hash is computed once
+# (longer data is in none of them, and goes to the slow path).
+_DIGITS = frozenset(bytes([d]) for d in b"0123456789")
+_DIRECTIONS = {bytes([c]): frozenset(bytes([d]) for d in directions) for c, directions in BY_BYTES.items()}
+# A pause of at most this many milliseconds cannot round to more than INTER_BYTE_TIMEOUT_MS: no rounding needed.
+_SURELY_IN_TIME = INTER_BYTE_TIMEOUT_MS - 1.0
 
 
 class StreamDecoder:
@@ -39,7 +45,7 @@ class StreamDecoder:
     def __init__(self, time_fn: Callable[[], float] = time.monotonic) -> None:
         self._time_fn = time_fn
         self._pending = b""  # the start of a frame: always a valid prefix, shorter than WIRE_LENGTH
-        self._last_ms = 0
+        self._last_ms = 0.0  # milliseconds, as received: rounded only near the timeout
         self._errors = dict.fromkeys(ErrorKind, 0)
 
     @property
@@ -60,44 +66,46 @@ class StreamDecoder:
             now = self._time_fn()
         if now.__class__ is not float or data.__class__ is not bytes:
             data, now = _checked(data, now)
-        try:
-            # Whole milliseconds, as the Arduino counts them: a float difference would put a gap of exactly
-            # INTER_BYTE_TIMEOUT_MS on either side of the limit depending on the clock's magnitude.
-            now_ms = round(now * 1000.0)
-        except (OverflowError, ValueError):
-            raise ClockError(f"now must be a finite number of seconds, not {now!r}") from None
+        ms = now * 1000.0
+        if ms - ms != 0.0:  # inf or nan
+            raise ClockError(f"now must be a finite number of seconds, not {now!r}")
         pending = self._pending
-        if pending and data and now_ms - self._last_ms > INTER_BYTE_TIMEOUT_MS:
-            self._errors[ErrorKind.TIMEOUT] += 1
-            pending = self._pending = b""
+        if pending and not ms - self._last_ms <= _SURELY_IN_TIME:
+            pending = self._timed_out(ms, data)
         if not data:
             return []
-        self._last_ms = now_ms
-        if len(data) == 1:
-            # One byte at a time, the usual way a serial port is read: the common cases in a few steps.
-            byte = data[0]
-            n = len(pending)
-            if n == 0:
-                if byte in BY_BYTES:
-                    self._pending = data
-                else:
-                    self._errors[ErrorKind.BAD_CATEGORY] += 1
-                return []
-            if n == 1:
-                if byte in BY_BYTES[pending[0]]:
+        self._last_ms = ms
+        # One byte at a time, the usual way a serial port is read: the common cases in a few steps, the most
+        # common first (a byte of the value).
+        n = len(pending)
+        if n > 1:
+            if n < _DIGITS_END:
+                if data in _DIGITS:
                     self._pending = pending + data
                     return []
-            elif n < _DIGITS_END:
-                if 0x30 <= byte <= 0x39:
-                    self._pending = pending + data
-                    return []
-            elif n == _LAST:  # the frame's last byte: a whole valid frame, or the slow path says what is wrong
+            elif n == _LAST and len(data) == 1:  # a whole valid frame, or the slow path says what is wrong
                 frame = pending + data
                 command = DECODED.get(frame) or valid(frame)
                 if command is not None:
                     self._pending = b""
                     return [command]
+        elif n:
+            if data in _DIRECTIONS[pending]:
+                self._pending = pending + data
+                return []
+        elif data in _DIRECTIONS:
+            self._pending = data
+            return []
         return self._scan(pending + data)
+
+    def _timed_out(self, ms: float, data: bytes) -> bytes:
+        """The pending bytes, dropped as a timeout if `data` came more than INTER_BYTE_TIMEOUT_MS after the last
+        bytes. In whole milliseconds, as the Arduino counts them: a float difference would put a gap of exactly
+        INTER_BYTE_TIMEOUT_MS on either side of the limit depending on the clock's magnitude."""
+        if data and round(ms) - round(self._last_ms) > INTER_BYTE_TIMEOUT_MS:
+            self._errors[ErrorKind.TIMEOUT] += 1
+            self._pending = b""
+        return self._pending
 
     def _scan(self, data: bytes) -> list[Command]:
         out: list[Command] = []
