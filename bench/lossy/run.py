@@ -175,14 +175,15 @@ def fly(job: tuple[str, int, float, str, str]) -> FlightFigures:
     return figures
 
 
-def campaign(exe: str, integrity: str, seeds: int, processes: int) -> list[FlightFigures]:
-    jobs = [(SCENARIOS[s % len(SCENARIOS)], 1 + s, rate, integrity, exe) for rate in RATES for s in range(seeds)]
+def campaign(exe: str, integrity: str, seeds: int, processes: int,
+             rates: tuple[float, ...] = RATES) -> list[FlightFigures]:
+    jobs = [(SCENARIOS[s % len(SCENARIOS)], 1 + s, rate, integrity, exe) for rate in rates for s in range(seeds)]
     ctx = multiprocessing.get_context("spawn")  # a forked child would inherit MuJoCo's GL context
     with ctx.Pool(processes) as pool:
         return pool.map(fly, jobs, chunksize=1)
 
 
-def crc8_campaign(seeds: int, processes: int, work: Path) -> list[FlightFigures]:
+def crc8_campaign(seeds: int, processes: int, work: Path, rates: tuple[float, ...] = RATES) -> list[FlightFigures]:
     """Regenerate a crc8 copy of the spec, build its virtual drone, fly in a child that imports that codec."""
     spec = (REPO / "spec" / "drone.yaml").read_text(encoding="utf-8")
     assert "  integrity: none\n" in spec, "the shipped spec's integrity line moved"
@@ -196,7 +197,8 @@ def crc8_campaign(seeds: int, processes: int, work: Path) -> list[FlightFigures]
                    capture_output=True)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(out / "python"), str(REPO)]))
     child = subprocess.run([py, "-m", "bench.lossy.run", "--child", "--virtual-drone", str(work / "fw" / "host" /
-                            "virtual_drone"), "--seeds", str(seeds), "--processes", str(processes)],
+                            "virtual_drone"), "--seeds", str(seeds), "--processes", str(processes),
+                            "--rates", ",".join(f"{r:g}" for r in rates)],
                            cwd=REPO, env=env, check=True, capture_output=True, text=True)
     return [FlightFigures(**{**d, "episodes": [tuple(e) for e in d["episodes"]]}) for d in json.loads(child.stdout)]
 
@@ -204,7 +206,7 @@ def crc8_campaign(seeds: int, processes: int, work: Path) -> list[FlightFigures]
 def summarise(rows: list[FlightFigures]) -> list[dict[str, Any]]:
     table = []
     for integrity in sorted({r.integrity for r in rows}, key=lambda m: m != "none"):
-        for rate in RATES:
+        for rate in sorted({r.rate for r in rows}):
             sel = [r for r in rows if r.integrity == integrity and r.rate == rate]
             if not sel:
                 continue
@@ -250,26 +252,38 @@ def markdown(table: list[dict[str, Any]], seeds: int, took_s: float) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _rates(text: str) -> tuple[float, ...]:
+    try:
+        rates = tuple(float(r) for r in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not comma-separated numbers: {text!r}") from None
+    if not all(0.0 <= r < 1.0 for r in rates):
+        raise argparse.ArgumentTypeError(f"a loss rate is a probability under 1: {text!r}")
+    return rates
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--seeds", type=int, default=8, help="flights per loss rate (default 8)")
     p.add_argument("--processes", type=int, default=2)
     p.add_argument("--virtual-drone", default=str(REPO / "firmware" / "build" / "host" / "virtual_drone"))
+    p.add_argument("--rates", type=_rates, default=RATES, help="loss rates per byte, comma-separated "
+                   "(default 0,0.01,0.02,0.1)")
     p.add_argument("--integrity", choices=("none", "crc8", "both"), default="both")
     p.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     p.add_argument("--no-write", action="store_true")
     args = p.parse_args()
     if args.child:
-        child_rows = campaign(args.virtual_drone, dp.INTEGRITY, args.seeds, args.processes)
+        child_rows = campaign(args.virtual_drone, dp.INTEGRITY, args.seeds, args.processes, args.rates)
         print(json.dumps([asdict(r) for r in child_rows]))
         return
     started = time.monotonic()
     rows: list[FlightFigures] = []
     if args.integrity in ("none", "both"):
-        rows += campaign(args.virtual_drone, dp.INTEGRITY, args.seeds, args.processes)
+        rows += campaign(args.virtual_drone, dp.INTEGRITY, args.seeds, args.processes, args.rates)
     if args.integrity in ("crc8", "both"):
         with tempfile.TemporaryDirectory(prefix="lossy-crc8-") as work:
-            rows += crc8_campaign(args.seeds, args.processes, Path(work))
+            rows += crc8_campaign(args.seeds, args.processes, Path(work), args.rates)
     table = summarise(rows)
     text = markdown(table, args.seeds, time.monotonic() - started)
     print(text)
