@@ -85,6 +85,7 @@ class ControllerCore:
         self._emergency = False
         self.fired = False  # the laser was on at the target for the whole fire time
         self.last_command: bytes | None = None
+        self.polling = False  # this tick's frame is a status poll (the runner sends it more than once)
         self._entered_ms = self._now()
         self._hits = 0
         self._misses = 0
@@ -205,6 +206,7 @@ class ControllerCore:
     def update(self, det: Detection | None) -> bytes | None:
         """One frame's decision. ``det`` is None when there is no frame this tick."""
         self._account()
+        self.polling = False
         if self.state is State.LAND and (self._elapsed() >= self.cfg.land_ms or self.gave_up):
             # stop sending: the firmware's failsafe (laser off, failsafe throttle) takes over
             self._go(State.DONE, f"drone did not confirm it disarmed ({self.drone.describe()})")
@@ -291,7 +293,10 @@ class ControllerCore:
     def _status_poll(self) -> bytes | None:
         """Waiting for the drone to confirm a change: a harmless frame every tick, since only a reply tells
         (refused as busy during a sequence); nothing when no drone answers (a dry run)."""
-        return None if self.drone.state is None else self._emit(dp.hold_altitude())
+        if self.drone.state is None:
+            return None
+        self.polling = True
+        return self._emit(dp.hold_altitude())
 
     def _on_takeoff(self, det: Detection | None) -> bytes | None:
         if self._elapsed() >= self.cfg.takeoff_ms:

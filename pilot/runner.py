@@ -4,7 +4,7 @@ The same loop flies the real drone (a camera, a serial link, wall-clock pacing) 
 one (the simulated camera, the virtual drone's pty, the world's stepped clock as the pacer).
 
 Each tick reads the replies first (the pilot's view of the drone is what they confirm), then decides and
-sends one frame.
+sends one frame (a status poll ``POLL_COPIES`` times: each copy gets its own reply).
 
 Safety: whatever ends the loop — the mission done, the time limit, the end of a video, a lost camera,
 Ctrl-C/SIGTERM (``KeyboardInterrupt``), or an exception in any stage (source, detector, controller,
@@ -201,7 +201,8 @@ def run(
                 break
             det = detector.detect(frame.image)
             command = controller.update(det)
-            command = link.send(sink, command, now, keepalive_ms, controller.state is not State.DONE)
+            command = link.send(sink, command, now, keepalive_ms, controller.state is not State.DONE,
+                                _copies(controller))
             tick = Tick(
                 ticks, now, frame, det, controller.state, command, tuple(replies), frame_wall,
                 wall_clock() if command is not None else None,
@@ -236,6 +237,13 @@ def run(
     return result
 
 
+# A status poll (the controller waiting for the drone to confirm a change: arming, landing, disarming) goes out
+# this many times in its tick. Only a reply confirms a change, and each copy gets one: over a link losing 10 % of
+# its bytes, a frame and its reply both survive about one tick in four (bench/lossy). Every other frame goes out
+# once: a copy is another chance for a damaged byte to make another command of it where no check catches that.
+POLL_COPIES = 3
+
+
 class _LinkState:
     """When the last frame went out (the keep-alive and the failsafe countdown start there)."""
 
@@ -243,14 +251,21 @@ class _LinkState:
         self.last_send = -math.inf
         self.last_ok = now
 
-    def send(self, sink: Sink, command: bytes | None, now: float, keepalive_ms: int, alive: bool) -> bytes | None:
+    def send(self, sink: Sink, command: bytes | None, now: float, keepalive_ms: int, alive: bool,
+             copies: int = 1) -> bytes | None:
         if command is None and alive and (now - self.last_send) * 1000.0 >= keepalive_ms:
             command = dp.hold_altitude()  # keep-alive: shorter than the firmware's command timeout
         if command is not None:
             self.last_send = now
-            if sink.send(command):
+            for _ in range(copies):
+                if not sink.send(command):
+                    break
                 self.last_ok = now
         return command
+
+
+def _copies(controller: Controller) -> int:
+    return POLL_COPIES if controller.polling else 1
 
 
 def _poll(sink: Sink, controller: Controller) -> list[dp.Reply]:
@@ -282,7 +297,7 @@ def _shutdown(
             before = pacer.now()
             _guarded(result, "poll", lambda: _poll(sink, controller))
             frame = controller.update(None)
-            sent = link.send(sink, frame, pacer.now(), keepalive_ms, True)
+            sent = link.send(sink, frame, pacer.now(), keepalive_ms, True, _copies(controller))
             if sent is not None:
                 result.safe_frames.append(sent)
             pacer.wait_tick()

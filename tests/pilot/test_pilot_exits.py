@@ -16,47 +16,16 @@ import drone_protocol as dp
 import numpy as np
 import yaml
 from fake_drone import FakeDrone, PtyDrone
+from runner_rig import Clock, Frames
 
 from pilot.config import ControllerConfig
 from pilot.controller import Controller, State
 from pilot.detect import Detection
 from pilot.errors import PortLost
 from pilot.runner import RunResult, run
-from pilot.sources import Frame
 
 REPO = Path(__file__).resolve().parents[2]
 N = dp.CommandName
-
-
-class Clock:
-    t = 100.0
-
-    def now(self) -> float:
-        return self.t
-
-    def wait_tick(self) -> None:
-        self.t += 0.05
-
-
-class Frames:
-    """Frames until ``interrupt_at_s`` (then a Ctrl-C in flight)."""
-
-    def __init__(self, clock: Clock, interrupt_at_s: float) -> None:
-        self.clock, self.at = clock, interrupt_at_s
-
-    def read(self) -> Frame:
-        if self.clock.t > self.at:
-            raise KeyboardInterrupt
-        return Frame(np.zeros((240, 320, 3), np.uint8), self.clock.t, 0)
-
-    def close(self) -> None:
-        pass
-
-    def __enter__(self) -> Frames:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        pass
 
 
 class Seen:
