@@ -70,7 +70,7 @@ class StreamDecoder:
         if ms - ms != 0.0:  # inf or nan
             raise ClockError(f"now must be a finite number of seconds, not {now!r}")
         pending = self._pending
-        if pending and not ms - self._last_ms <= _SURELY_IN_TIME:
+        if pending and ms - self._last_ms > _SURELY_IN_TIME:  # both finite
             pending = self._timed_out(ms, data)
         if not data:
             return []
