@@ -73,8 +73,9 @@ A frame where still nothing scores ``SECOND_LOOK_UNLESS`` gets a circle look (pi
 look's ``CIRCLE_BLOBS`` largest blobs' windows, circles of brightness edges, then of colour edges (the best of each
 octave of radii), with the target's colour inside (one circle to a window: several are a texture of round things, a
 flower's petals). A ball on a textured surface of its colour, which even the edges cut into pieces (its shading is
-an edge inside it), is one blob with that surface; only its rim tells it apart. It costs about 2 ms a window, in
-frames with no ball.
+an edge inside it), is one blob with that surface; only its rim tells it apart. A window with no circle whose rim is
+whole takes one whose rim is nearly so and whose middle is lit as a ball's (pilot/hsv_dome.py): JPEG's blocks break
+a ball's rim in places. It costs about 2 ms a window, in frames with no ball.
 
 Every look drops the blobs from ``hsv_inside.FROM`` px across that are brightness edges inside (pilot/hsv_inside.py):
 a round texture of the target's colour (a dahlia's heart, its red cups merged by JPEG's blocks), not a plain ball;

@@ -16,6 +16,21 @@ from ``hsv_rim.COLOUR_FROM`` across, as a colour rim does. On the five dev seed 
 not the report's): 24 balls more (motion blur 7, Gaussian blur 4, warm light 5), none fewer, the same false
 detections; without the size bound, 28 more and 2 false detections more (circles of 16-17 px). It doubles the
 circle look's cost (1.2 -> 2.2 ms a window on those views), in frames where nothing else scored.
+
+A window with no circle whose rim is whole (``WHOLE``) takes its circles from ``COLOUR_FROM`` across with a rim of
+``DOMED_RIM`` whose middle is lit as a ball's (pilot/hsv_dome.py): JPEG's blocks, or a dark ground behind a ball's
+shaded side, leave parts of its rim with no edge, while a ball lit from the camera's side is brighter in its middle
+than near its limb, and a flat red thing or a cup is not. On the dev seed sets of bench/vision (not the report's),
+chosen on the tuning photos' sets (6,099 balls from 16 px; 9,750 empty, distractor and red-shape views):
+
+  | rim from | middle over limb | balls (tuning sets) | false detections (tuning sets) |
+  |---|---|---|---|
+  | 0.7 | 0.1 | +7 | the same |
+  | 0.65 | 0.15 | +11 | +1 |
+  | 0.65 | 0.1 | +16 | +4 |
+
+then on the validation photos' sets with 0.7 and 0.1: +5 balls of 4,039, a red shape more in 6,000 views. In all,
+12 balls more of 10,138, none fewer (7 of them JPEG), and one false detection more in 15,750 views with no ball.
 """
 
 from __future__ import annotations
@@ -29,6 +44,7 @@ import numpy.typing as npt
 from cv2.typing import MatLike
 
 from .hsv_colour import ColourMask
+from .hsv_dome import domed
 from .hsv_inside import CANNY
 from .hsv_rim import COLOUR_FROM, WHOLE, best_rim
 from .hsv_score import Features
@@ -46,6 +62,8 @@ PER_BAND = 2  # ...and the best centres of each checked per window. Ranked toget
 INSIDE = 0.95  # the share of points inside the circle (to 0.8 radii) in the mask. At 0.85, the dark hollows of a
 # dahlia's petals passed: on the validation photos' dev seeds, 115 of 2,400 empty views with a detection, 61 at 0.95;
 # 3 balls fewer of 3,400 on the tuning photos' (bench/vision/vision_imagery.py)
+DOMED_RIM = 0.7  # a circle from COLOUR_FROM across with a rim this whole counts if it is domed (pilot/hsv_dome.py),
+# where a window has no circle with a whole rim
 
 _NEAR = np.ones((5, 5), np.uint8)  # edges this close to the mask vote (a rim lies just outside the blob's mask)
 _PEAK = np.ones((3, 3), np.uint8)
@@ -58,6 +76,7 @@ class Circle(NamedTuple):
     r: float
     inside: float  # share of the mask inside
     rim: float  # rim support
+    domed: bool = False  # taken with a rim short of WHOLE for its middle lit as a ball's (pilot/hsv_dome.py)
 
 
 class Grid(NamedTuple):
@@ -150,12 +169,14 @@ def inside_share(mask: MatLike, cx: float, cy: float, r: float) -> float:
 def circles(roi: MatLike, mask: MatLike, frame: MatLike, x0: int, y0: int) -> list[Circle]:
     """The circles in the window at (x0, y0) of ``frame`` (``roi``, its smoothed pixels; ``mask``, its colour
     mask) with the target's colour inside and a rim all round: the circle the rim support fits best (measured on
-    the frame: unsmoothed, and not cut by the window's edge)."""
+    the frame: unsmoothed, and not cut by the window's edge). A window with none gives its domed circles instead:
+    from ``COLOUR_FROM`` across, a rim of ``DOMED_RIM``, the middle lit as a ball's."""
     r_max = max(mask.shape[:2]) / 2.0
     near = cv2.dilate(mask, _NEAR)  # where the edges vote, in brightness and in colour
     voted = [(c, 0.0) for c in centres(cv2.cvtColor(roi, cv2.COLOR_BGR2GRAY), near, r_max)]
     voted += [(c, COLOUR_FROM) for c in centres(roi, near, r_max)]  # in colour: counted from COLOUR_FROM across
     out: list[Circle] = []
+    dome: list[Circle] = []
     for (cx, cy, r), least in voted:
         inside = inside_share(mask, cx, cy, r)
         if inside < INSIDE:
@@ -163,7 +184,9 @@ def circles(roi: MatLike, mask: MatLike, frame: MatLike, x0: int, y0: int) -> li
         rim, bx, by, br = best_rim(frame, cx + x0, cy + y0, r, colour=True)
         if rim >= WHOLE and 2.0 * br >= least:  # two centres may fit one rim (in brightness and in colour): both kept,
             out.append(Circle(bx - x0, by - y0, br, inside, rim))  # their inside read where each was voted for
-    return out
+        elif rim >= DOMED_RIM and 2.0 * br >= COLOUR_FROM and domed(frame, bx, by, br):
+            dome.append(Circle(bx - x0, by - y0, br, inside, rim, domed=True))
+    return out or dome
 
 
 def _objects(found: list[Circle]) -> int:
@@ -205,5 +228,5 @@ def circle_features(roi: MatLike, hsv: MatLike, mask: MatLike, frame: MatLike, x
         mean = cv2.mean(hsv, mask=cv2.bitwise_and(disc, mask))
         out.append(Features(c.cx + x0, c.cy + y0, 2.0 * c.r, 0.0, 1.0, c.inside, 1.0, math.pi / 4.0, float(mean[1]),
                             colour.hue_off(float(mean[0])), 0.0 if 2.0 * c.r >= COLOUR_FROM else 1.0 - c.rim, 0.0,
-                            c.rim))
+                            c.rim, c.domed))
     return out

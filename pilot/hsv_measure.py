@@ -196,7 +196,8 @@ class BlobMeasure:
         return s
 
     def _score(self, f: Features, width: int) -> float:
-        shape = max(arc_score(f.arc, f.ellipse_arc), ramp(f.rim, *RIM)) if f.rim else arc_score(f.arc, f.ellipse_arc)
+        rim = 1.0 if f.domed else ramp(f.rim, *RIM)
+        shape = max(arc_score(f.arc, f.ellipse_arc), rim) if f.rim else arc_score(f.arc, f.ellipse_arc)
         shape *= ramp(f.solidity, *SOLIDITY) * ramp(f.fill, *FILL)
         shape *= stretch_score(f.elongation, f.arc) * box_score(f.box_fill, f.size) * self._size_score(f.size, width)
         colour = ramp(f.saturation, self.colour.sat_lo + SATURATION[0], self.colour.sat_lo + SATURATION[1])

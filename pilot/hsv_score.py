@@ -49,6 +49,8 @@ class Features(NamedTuple):
     ring: float  # the ring's share of the target's colour (a piece cut by edges: its rim's share not walled in)
     ellipse_arc: float  # 0 where the circle's arc was enough (it is measured only below ARC's one)
     rim: float  # the rim support (pilot/hsv_rim.py), 0 unless measured (the rim and circle looks, small edge pieces)
+    domed: bool = False  # a circle look's circle taken for its middle lit as a ball's (pilot/hsv_dome.py): its rim,
+    # short of a whole one, counts as whole
 
 
 def ramp(value: float, zero: float, one: float) -> float:

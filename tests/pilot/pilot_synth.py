@@ -14,6 +14,7 @@ Image = npt.NDArray[np.uint8]
 FloatImage = npt.NDArray[np.float64]
 
 RED = (30, 30, 210)  # BGR
+CX, CY = 160, 120  # the centre of a 320x240 frame, where on_surface puts a ball
 DISTRACTORS = {
     "blue": (200, 80, 30),
     "green": (40, 180, 40),
@@ -84,3 +85,19 @@ def best_hsv(img: Image) -> tuple[float, float, float] | None:
     """The colour-ball detector's best candidate in ``img`` (centre and score), None without one."""
     found = HsvBlobDetector().candidates(img)
     return (found[0].cx, found[0].cy, found[0].score) if found else None
+
+
+def red_surface(seed: int, texture: float, value: float = 90.0) -> npt.NDArray[np.float64]:
+    """A red surface whose brightness varies in blotches about 6 px across (BGR, float)."""
+    blotches = cv2.GaussianBlur(np.random.default_rng(seed).normal(0.0, 1.0, (240, 320)), (0, 0), 3)
+    v = np.clip(value + texture * blotches / blotches.std(), 0, 255)
+    return np.stack([0.2 * v, 0.2 * v, v], axis=-1)
+
+
+def on_surface(r: float, seed: int, texture: float,
+               centres: tuple[tuple[float, float], ...] = ((CX, CY),)) -> Image:
+    """Matte red balls of radius ``r`` at ``centres``, lit from the upper left, on ``red_surface``."""
+    img = red_surface(seed, texture)
+    for cx, cy in centres:
+        img = matte_ball(img, cx, cy, r, (0.15 * 220.0, 0.15 * 220.0, 220.0), 0.3)
+    return np.asarray(np.clip(img, 0, 255), np.uint8)

@@ -11,7 +11,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 import pytest
-from pilot_synth import matte_ball
+from pilot_synth import CX, CY, on_surface, red_surface
 
 import pilot.hsv as hsv
 import pilot.hsv_circles as hsv_circles
@@ -19,22 +19,6 @@ from pilot.hsv_circles import Circle, _objects, centres, circles, inside_share
 from pilot.hsv_rim import COLOUR_FROM, WHOLE
 
 Image = npt.NDArray[np.uint8]
-CX, CY = 160, 120
-
-
-def red_surface(seed: int, texture: float, value: float = 90.0) -> npt.NDArray[np.float64]:
-    """A red surface whose brightness varies in blotches about 6 px across (BGR, float)."""
-    blotches = cv2.GaussianBlur(np.random.default_rng(seed).normal(0.0, 1.0, (240, 320)), (0, 0), 3)
-    v = np.clip(value + texture * blotches / blotches.std(), 0, 255)
-    return np.stack([0.2 * v, 0.2 * v, v], axis=-1)
-
-
-def on_surface(r: float, seed: int, texture: float, centres: tuple[tuple[float, float], ...] = ((CX, CY),)) -> Image:
-    """Matte red balls of radius ``r`` at ``centres``, lit from the upper left, on ``red_surface``."""
-    img = red_surface(seed, texture)
-    for cx, cy in centres:
-        img = matte_ball(img, cx, cy, r, (0.15 * 220.0, 0.15 * 220.0, 220.0), 0.3)
-    return np.asarray(np.clip(img, 0, 255), np.uint8)
 
 
 @pytest.mark.parametrize("r,seed,texture", [(9, 0, 20), (9, 1, 40), (12, 0, 40), (12, 1, 40)])
