@@ -26,6 +26,8 @@ colour rim found.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import cv2
 import numpy as np
 import numpy.typing as npt
@@ -66,8 +68,8 @@ def rim_support(bgr: MatLike, cx: float, cy: float, r: float, colour: bool = Fal
     side may be brighter than what lies behind it, its shaded side darker); ``colour``: see ``best_rim``."""
     if colour:  # the colour rim's inside check needs the best circle itself
         return best_rim(bgr, cx, cy, r, True)[0]
-    counts = _counts(bgr, cx, cy, r, False)
-    return 0.0 if counts is None else float(counts.max()) / len(_U)
+    window = _window(bgr, cx, cy, r)
+    return 0.0 if window is None else float(_counts(window, cx, cy, r, False).max()) / len(_U)
 
 
 def best_rim(bgr: MatLike, cx: float, cy: float, r: float,
@@ -75,19 +77,20 @@ def best_rim(bgr: MatLike, cx: float, cy: float, r: float,
     """``rim_support`` and the circle that has it (centre, radius). ``colour``: a rim short of ``WHOLE`` in
     brightness, from ``COLOUR_FROM`` px across, is measured in each colour channel too; that one counts if it
     reaches ``COLOUR_MIN`` and the circle is plain inside."""
-    rim = _best(bgr, cx, cy, r, False)
+    window = _window(bgr, cx, cy, r)
+    if window is None:
+        return 0.0, cx, cy, r
+    rim = _best(window, cx, cy, r, False)
     if colour and rim[0] < WHOLE and 2.0 * r >= COLOUR_FROM:
-        in_colour = _best(bgr, cx, cy, r, True)
+        in_colour = _best(window, cx, cy, r, True)
         _, bx, by, br = in_colour
         if in_colour[0] >= COLOUR_MIN and inside_edges(bgr, bx, by, 2.0 * br) <= EDGES_MAX:
             return in_colour
     return rim
 
 
-def _best(bgr: MatLike, cx: float, cy: float, r: float, colour: bool) -> tuple[float, float, float, float]:
-    counts = _counts(bgr, cx, cy, r, colour)
-    if counts is None:
-        return 0.0, cx, cy, r
+def _best(window: Window, cx: float, cy: float, r: float, colour: bool) -> tuple[float, float, float, float]:
+    counts = _counts(window, cx, cy, r, colour)
     top = counts == counts.max()
     # of the circles tied best, the widest (a ball's shading is an edge inside its rim, never outside it), their
     # centres averaged (a clean rim ties several around the true one)
@@ -97,9 +100,19 @@ def _best(bgr: MatLike, cx: float, cy: float, r: float, colour: bool) -> tuple[f
     return float(counts.max()) / len(_U), float(cx + dx * r), float(cy + dy * r), widest * r
 
 
-def _counts(bgr: MatLike, cx: float, cy: float, r: float, colour: bool) -> npt.NDArray[np.intp] | None:
-    """For each circle tried, how many of its points are on the rim (``colour``: in the channel where most
-    are); None where the window is too small."""
+class Window(NamedTuple):
+    """The pixels every circle tried near one reaches (a view of the image), where they start, and how much the
+    rim is read smaller (2 from ``HALF_FROM``)."""
+
+    roi: MatLike
+    x0: int
+    y0: int
+    k: int
+
+
+def _window(bgr: MatLike, cx: float, cy: float, r: float) -> Window | None:
+    """The window of the circles tried near (cx, cy, r), cut once for the rim in brightness and in colour; None where
+    it is too small."""
     h, w = bgr.shape[:2]
     k = 2 if r >= HALF_FROM else 1
     reach = _REACH * r + 2.0 * k
@@ -108,10 +121,16 @@ def _counts(bgr: MatLike, cx: float, cy: float, r: float, colour: bool) -> npt.N
     x1, y1 = x0 + (x1 - x0) // k * k, y0 + (y1 - y0) // k * k
     if x1 - x0 < 3 * k or y1 - y0 < 3 * k:
         return None
-    roi = bgr[y0:y1, x0:x1]  # a view: OpenCV reads its rows in place
+    return Window(bgr[y0:y1, x0:x1], x0, y0, k)  # a view: OpenCV reads its rows in place
+
+
+def _counts(window: Window, cx: float, cy: float, r: float, colour: bool) -> npt.NDArray[np.intp]:
+    """For each circle tried, how many of its points are on the rim (``colour``: in the channel where most
+    are)."""
+    roi, x0, y0, k = window
     img = roi if colour else cv2.cvtColor(roi, cv2.COLOR_BGR2GRAY)
     if k > 1:
-        img = cv2.resize(img, ((x1 - x0) // k, (y1 - y0) // k), interpolation=cv2.INTER_AREA)
+        img = cv2.resize(img, (roi.shape[1] // k, roi.shape[0] // k), interpolation=cv2.INTER_AREA)
     gh, gw = img.shape[:2]
     gx = cv2.Sobel(img, cv2.CV_32F, 1, 0, ksize=3)
     gy = cv2.Sobel(img, cv2.CV_32F, 0, 1, ksize=3)

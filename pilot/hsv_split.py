@@ -24,7 +24,7 @@ RIM_MIN = 0.35  # of a circle just outside a disc that leaves the blob: less is 
 # fits inside a wide region has its nearest edge on one side); it halves the discs refined, not the recall
 SPLIT_OPEN = 0.5  # the opening's disc, in radii of the disc found (0.6 let opened squares through: red_shape)
 SPLIT_CUT = 0.1  # the opening must cut off this much (of the piece's area): else the blob was joined to nothing
-HUE_PIECES = 2  # the largest round pieces of each hue (or saturation) class refined
+CLASS_PIECES = 2  # the largest round pieces of each colour class (of hue or saturation) refined
 HUE_GAP = 4.0  # hue units between the means of a blob's two hue classes (Otsu) for a split by hue (3: more
 # false detections on the tuning photos' empty views, 2: more still)
 SAT_GAP = 16.0  # saturation units between the means of a blob's two saturation classes for a split by saturation
@@ -128,7 +128,7 @@ def colour_pieces(hsv: MatLike, mask: MatLike, joined: Sequence[tuple[float, Mat
                   clean: Callable[[MatLike], MatLike]) -> Iterator[tuple[Bounds, Box, int]]:
     """For each joined blob (area, contour, box in the search ``hsv`` and its ``mask``) whose pixels fall in two hue
     classes, or else in two saturation classes: each class's range (``bounds``, one range, narrowed in that
-    channel), the ``HUE_PIECES`` largest round pieces of the blob in it (their boxes in the search; ``clean``: the
+    channel), the ``CLASS_PIECES`` largest round pieces of the blob in it (their boxes in the search; ``clean``: the
     detector's mask cleaning) and the channel split. A saturation class holding round pieces of a size is a texture
     of round things (a dahlia's cups), not a ball on a surface: none of its pieces."""
     ((lo, hi),) = bounds
@@ -150,7 +150,7 @@ def colour_pieces(hsv: MatLike, mask: MatLike, joined: Sequence[tuple[float, Mat
             pieces = round_pieces(sub, min_area, min_fill)
             if channel == SATURATION and _patterned(pieces):
                 continue
-            for _, (px, py, pw, ph) in pieces[:HUE_PIECES]:
+            for _, (px, py, pw, ph) in pieces[:CLASS_PIECES]:
                 yield [(sub_lo, sub_hi)], (px + x, py + y, pw, ph), channel
 
 

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from multiprocessing import Pool
 from pathlib import Path
@@ -109,16 +110,20 @@ def load(run: str, name: str, out: Path = OUT) -> list[View]:
     return [View(k, g, s, x, y, p, [tuple(c) for c in cs]) for k, g, s, x, y, p, cs in json.loads(path.read_text())]
 
 
+def as_record(v: View) -> ve.Record:
+    """The view as bench/vision's record of its best candidate, which ``vision_eval``'s rules read."""
+    best = v.candidates[0] if v.candidates else None
+    error = math.hypot(best[0] - v.cx, best[1] - v.cy) if best is not None and v.kind == "target" else math.inf
+    return ve.Record(v.kind, v.group, v.size, best is not None, best[3] if best else 0.0, error, v.photo)
+
+
 def correct(v: View, threshold: float) -> bool:
     """A target view whose best candidate scores ``threshold`` at the truth (bench/vision's rule)."""
-    if v.kind != "target" or not v.candidates or v.candidates[0][3] < threshold:
-        return False
-    cx, cy = v.candidates[0][:2]
-    return bool(np.hypot(cx - v.cx, cy - v.cy) <= ve.tolerance(v.size))
+    return v.kind == "target" and ve.correct(as_record(v), threshold)
 
 
 def detected(v: View, threshold: float) -> bool:
-    return bool(v.candidates) and v.candidates[0][3] >= threshold
+    return ve.detected(as_record(v), threshold)
 
 
 class Diff(NamedTuple):

@@ -87,4 +87,4 @@ def test_round_pieces_of_a_size_in_one_saturation_class_are_a_texture(monkeypatc
     img = frame([(60.0 + 60.0 * k, CY) for k in range(5)], r=12.0)
     assert not [p for p in pieces(img) if abs(p[0][1] + p[0][3] / 2.0 - CY) <= 2.0]
     monkeypatch.setattr(hsv_split, "_patterned", lambda _: False)
-    assert len([p for p in pieces(img) if abs(p[0][1] + p[0][3] / 2.0 - CY) <= 2.0]) == hsv_split.HUE_PIECES
+    assert len([p for p in pieces(img) if abs(p[0][1] + p[0][3] / 2.0 - CY) <= 2.0]) == hsv_split.CLASS_PIECES
