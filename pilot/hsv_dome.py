@@ -3,7 +3,8 @@
 A matte ball's brightness is a plane (the light's side) plus a term that follows the surface's slope towards the
 camera: a ring round the centre averages the plane out, so the middle stands above a ring at 0.8 radii by about 0.4
 of that term, whichever side the light comes from, as long as some of it comes from the camera's side. A flat red
-thing (a poster, a box's face, the saucer a ball lies on) reads level; a cup reads lower in its middle.
+thing (a poster, a box's face, the saucer a ball lies on) reads level; a cup reads lower in its middle. A rounded red
+knob (the end of a cup's handle, on bench/vision's fresh dev seeds) is domed as a ball is, and passes.
 
 The circle look (pilot/hsv_circles.py) takes a circle with a rim short of ``hsv_rim.WHOLE`` when it is domed: JPEG's
 blocks and a dark ground behind a ball's shaded side leave part of a ball's rim with no edge. A ball lit from behind
