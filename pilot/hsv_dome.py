@@ -22,23 +22,18 @@ from .hsv_shape import unit_circle
 RISE = 0.1  # the middle over the ring, as a share of their mean brightness
 _MIDDLE = np.concatenate([0.2 * unit_circle(8), np.zeros((1, 2))])  # the middle, to 0.2 radii: 9 points
 _LIMB = 0.8 * unit_circle(24)  # the ring at 0.8 radii (the rim's own edge blurs inwards beyond it)
+_POINTS = np.concatenate([_MIDDLE, _LIMB])
 
 
 def domed(bgr: MatLike, cx: float, cy: float, r: float) -> bool:
     """Whether the circle (cx, cy, r) of ``bgr`` is brighter in its middle than at 0.8 radii by ``RISE`` of their
-    mean grey level; False when the ring leaves the image."""
+    mean grey level; False when the ring leaves the image. Only the 33 points read are made grey (as
+    pilot/hsv_hollow.py reads its sectors)."""
     h, w = bgr.shape[:2]
-    reach = int(r) + 2
-    x0, y0 = max(0, int(cx) - reach), max(0, int(cy) - reach)
-    x1, y1 = min(w, int(cx) + reach + 1), min(h, int(cy) + reach + 1)
-    if x1 - x0 < 3 or y1 - y0 < 3:
+    pts = (_POINTS * r + (cx + 0.5, cy + 0.5)).astype(np.intp)  # + 0.5: truncation rounds
+    if pts.min() < 0 or pts[:, 0].max() >= w or pts[:, 1].max() >= h:
         return False
-    grey = cv2.cvtColor(bgr[y0:y1, x0:x1], cv2.COLOR_BGR2GRAY)  # a view: OpenCV reads its rows in place
-    levels = []
-    for unit in (_MIDDLE, _LIMB):
-        pts = (unit * r + (cx - x0 + 0.5, cy - y0 + 0.5)).astype(np.intp)
-        if pts.min() < 0 or pts[:, 0].max() >= x1 - x0 or pts[:, 1].max() >= y1 - y0:
-            return False
-        levels.append(float(grey[pts[:, 1], pts[:, 0]].mean()))
-    middle, limb = levels
+    pixels = np.asarray(bgr)[pts[:, 1], pts[:, 0]].reshape(1, -1, 3)
+    grey = cv2.cvtColor(pixels, cv2.COLOR_BGR2GRAY).ravel().astype(np.float64)
+    middle, limb = float(grey[: len(_MIDDLE)].mean()), float(grey[len(_MIDDLE):].mean())
     return middle - limb >= RISE * max(1.0, (middle + limb) / 2.0)

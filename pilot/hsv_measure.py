@@ -196,8 +196,9 @@ class BlobMeasure:
         return s
 
     def _score(self, f: Features, width: int) -> float:
-        rim = 1.0 if f.domed else ramp(f.rim, *RIM)
-        shape = max(arc_score(f.arc, f.ellipse_arc), rim) if f.rim else arc_score(f.arc, f.ellipse_arc)
+        shape = arc_score(f.arc, f.ellipse_arc)
+        if f.rim:  # read only when measured (a domed circle's, short of whole, counts as whole)
+            shape = max(shape, 1.0 if f.domed else ramp(f.rim, *RIM))
         shape *= ramp(f.solidity, *SOLIDITY) * ramp(f.fill, *FILL)
         shape *= stretch_score(f.elongation, f.arc) * box_score(f.box_fill, f.size) * self._size_score(f.size, width)
         colour = ramp(f.saturation, self.colour.sat_lo + SATURATION[0], self.colour.sat_lo + SATURATION[1])
