@@ -34,8 +34,10 @@ BALL_SIZES, MARKER_SIZES = (10.0, 120.0), (24.0, 120.0)
 VIEWS = 400  # per condition: about 320 targets of 16 px or more, a binomial spread of 1.6 points at 90 % (at 100
 # views, 3.3 points: the worst of nine conditions then reads several points under the detector's true recall)
 BLOCKS = 5  # timing blocks
+TIMING_SEED = 99  # the timing views' (the 320x240 ones first, then the 640x480 ones)
 TIMING_VIEWS = 200  # views timed: the median frame's cost depends on which blobs it holds, and 20 views' median read
 # 0.25-0.3x under 200 other views' on the same code (1.89-2.10x against 2.14-2.40x at 320x240, the eighteenth session)
+FLOOR_RANGE = (np.array((0, 120, 70), np.uint8), np.array((8, 255, 255), np.uint8))  # the floor's inRange bounds
 
 
 def pct(v: float) -> str:
@@ -63,25 +65,33 @@ def timing(repeat: int) -> list[str]:
     load on the machine then slows both alike), ArUco apart. ``BLOCKS`` blocks of ``repeat`` calls each: the ratio
     is the median block's, with the range of the blocks' (the shared machine's load moves it by 0.1x or more)."""
     cv2.setNumThreads(1)
-    rng = np.random.default_rng(99)
+    rng = np.random.default_rng(TIMING_SEED)
     hsv = HsvBlobDetector()
-    lo, hi = np.array((0, 120, 70), np.uint8), np.array((8, 255, 255), np.uint8)
     rows = ["| frame | cvtColor+inRange floor (ms) | HSV detection with scoring (ms) | ratio (blocks' range) | HSV, "
             "90th percentile (ms) | ArUco (ms) |", "|---|---|---|---|---|---|"]
     for w, h in ((320, 240), (640, 480)):
-        views = [vi.target_sample(rng, vi.TUNING, "clean", "ball", (20, 60)).image for _ in range(TIMING_VIEWS)]
-        frames = [np.asarray(cv2.resize(v, (w, h)), np.uint8) for v in views]
+        frames = timing_frames(rng, w, h)
         aruco = ArucoMarkerDetector()
-        blocks = [times(frames, repeat, lambda im: cv2.inRange(cv2.cvtColor(im, cv2.COLOR_BGR2HSV), lo, hi),
-                        hsv.candidates) for _ in range(BLOCKS)]
+        blocks = [times(frames, repeat, floor, hsv.candidates) for _ in range(BLOCKS)]
         ratios = sorted(statistics.median(d) / statistics.median(f) for f, d in blocks)
         floor_ms, hsv_ms = [t for f, _ in blocks for t in f], [t for _, d in blocks for t in d]
-        floor, det = statistics.median(floor_ms), statistics.median(hsv_ms)
+        base, det = statistics.median(floor_ms), statistics.median(hsv_ms)
         ar = statistics.median(times(frames, repeat, aruco.candidates)[0])
         p90 = sorted(hsv_ms)[int(0.9 * len(hsv_ms))]
-        rows.append(f"| {w}x{h} | {floor:.3f} | {det:.3f} | {statistics.median(ratios):.2f}x ({ratios[0]:.2f}-"
+        rows.append(f"| {w}x{h} | {base:.3f} | {det:.3f} | {statistics.median(ratios):.2f}x ({ratios[0]:.2f}-"
                     f"{ratios[-1]:.2f}x) | {p90:.3f} | {ar:.2f} |")
     return rows
+
+
+def timing_frames(rng: np.random.Generator, w: int, h: int) -> list[vi.Image]:
+    """``TIMING_VIEWS`` views of a clean ball 20-60 px across on the tuning photos, at ``w`` x ``h``."""
+    views = [vi.target_sample(rng, vi.TUNING, "clean", "ball", (20, 60)).image for _ in range(TIMING_VIEWS)]
+    return [np.asarray(cv2.resize(v, (w, h)), np.uint8) for v in views]
+
+
+def floor(image: vi.Image) -> object:
+    """What any colour detector pays: one HSV conversion and one ``inRange`` of the whole frame."""
+    return cv2.inRange(cv2.cvtColor(image, cv2.COLOR_BGR2HSV), FLOOR_RANGE[0], FLOOR_RANGE[1])
 
 
 def times(frames: list[vi.Image], repeat: int, *fns: Callable[[vi.Image], object]) -> list[list[float]]:
