@@ -48,7 +48,7 @@ from .hsv_dome import domed
 from .hsv_inside import CANNY
 from .hsv_rim import COLOUR_FROM, WHOLE, best_rim
 from .hsv_score import Features
-from .hsv_shape import unit_circle
+from .hsv_shape import pixels_at, unit_circle
 
 RADII = np.exp(np.arange(math.log(7.5), math.log(62.0), 0.15)).astype(np.float32)  # 15 % apart: 16-120 px balls
 CELL = 2  # px: the centre votes' grid
@@ -159,11 +159,8 @@ def _strongest(dx: MatLike, dy: MatLike, ys: npt.NDArray[np.intp],
 
 def inside_share(mask: MatLike, cx: float, cy: float, r: float) -> float:
     """The share of 49 points inside the circle (to 0.8 radii) set in the mask; 0 if any falls outside it."""
-    h, w = mask.shape[:2]
-    pts = (_INSIDE_POINTS * r + (cx + 0.5, cy + 0.5)).astype(np.intp)
-    if pts.min() < 0 or pts[:, 0].max() >= w or pts[:, 1].max() >= h:
-        return 0.0
-    return float(np.count_nonzero(np.asarray(mask)[pts[:, 1], pts[:, 0]])) / len(pts)
+    inside = pixels_at(mask, _INSIDE_POINTS, cx, cy, r)
+    return 0.0 if inside is None else float(np.count_nonzero(inside)) / len(inside)
 
 
 def circles(roi: MatLike, mask: MatLike, frame: MatLike, x0: int, y0: int) -> list[Circle]:

@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 from cv2.typing import MatLike
 
-from .hsv_shape import unit_circle
+from .hsv_shape import pixels_at, unit_circle
 
 RISE = 0.1  # the middle over the ring, as a share of their mean brightness
 _MIDDLE = np.concatenate([0.2 * unit_circle(8), np.zeros((1, 2))])  # the middle, to 0.2 radii: 9 points
@@ -29,11 +29,9 @@ def domed(bgr: MatLike, cx: float, cy: float, r: float) -> bool:
     """Whether the circle (cx, cy, r) of ``bgr`` is brighter in its middle than at 0.8 radii by ``RISE`` of their
     mean grey level; False when the ring leaves the image. Only the 33 points read are made grey (as
     pilot/hsv_hollow.py reads its sectors)."""
-    h, w = bgr.shape[:2]
-    pts = (_POINTS * r + (cx + 0.5, cy + 0.5)).astype(np.intp)  # + 0.5: truncation rounds
-    if pts.min() < 0 or pts[:, 0].max() >= w or pts[:, 1].max() >= h:
+    pixels = pixels_at(bgr, _POINTS, cx, cy, r)
+    if pixels is None:
         return False
-    pixels = np.asarray(bgr)[pts[:, 1], pts[:, 0]].reshape(1, -1, 3)
-    grey = cv2.cvtColor(pixels, cv2.COLOR_BGR2GRAY).ravel().astype(np.float64)
+    grey = cv2.cvtColor(pixels.reshape(1, -1, 3), cv2.COLOR_BGR2GRAY).ravel().astype(np.float64)
     middle, limb = float(grey[: len(_MIDDLE)].mean()), float(grey[len(_MIDDLE):].mean())
     return middle - limb >= RISE * max(1.0, (middle + limb) / 2.0)

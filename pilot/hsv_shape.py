@@ -24,6 +24,17 @@ def unit_circle(n: int) -> npt.NDArray[np.float64]:
     return np.stack([np.cos(angles), np.sin(angles)], axis=1)
 
 
+def pixels_at(image: MatLike, unit: npt.NDArray[np.float64], cx: float, cy: float,
+              r: float) -> npt.NDArray[Any] | None:
+    """The pixels of ``image`` at the points ``unit * r`` (offsets from cx, cy), in their order; None if any falls
+    outside the image."""
+    h, w = image.shape[:2]
+    pts = (unit * r + (cx + 0.5, cy + 0.5)).astype(np.intp)  # + 0.5: truncation rounds
+    if pts.min() < 0 or pts[:, 0].max() >= w or pts[:, 1].max() >= h:
+        return None
+    return np.asarray(image)[pts[:, 1], pts[:, 0]]
+
+
 CIRCLE_48 = unit_circle(48)
 # the ring from 1.25 to 1.75 radii, in radii: three circles of 48 points (sampling it costs a third of drawing it)
 RING_POINTS = np.asfortranarray(np.concatenate([k * CIRCLE_48 for k in (1.33, 1.5, 1.67)]))  # x, y = .T contiguous
