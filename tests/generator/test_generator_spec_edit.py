@@ -253,6 +253,23 @@ def test_a_new_init_command_needs_no_other_change(tmp_path: Path) -> None:
     assert proc.stdout.strip() == "b'iz0000' zoom", proc.stderr
 
 
+def test_a_speed_direction_without_a_default_generates_and_needs_a_value(tmp_path: Path) -> None:
+    # a spec mutation found it: the docs' movement table printed the example frame of a default there was none of
+    text = h.edited_spec(("        description: Strafe left\n        channel: roll\n        default: low\n",
+                          "        description: Strafe left\n        channel: roll\n"))
+    spec = tmp_path / "drone.yaml"
+    spec.write_text(text)
+    run = h.generate("--spec", spec, "--out", tmp_path / "out")
+    assert run.code == 0, run.stderr
+    docs = (tmp_path / "out" / "docs" / "protocol.md").read_text()
+    assert "| `l` | Strafe left | none: required | 1000–2000 | roll | `ml1000` |" in docs
+    env = {**os.environ, "PYTHONPATH": str(tmp_path / "out" / "python")}
+    code = ("import drone_protocol as p; print(p.move_left(1400))\n"
+            "try:\n p.move_left()\nexcept TypeError: print('required')")
+    proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
+    assert proc.stdout.split() == ["b'ml1400'", "required"], proc.stderr
+
+
 AVR_SKETCH = """
 #include <DroneProtocol.h>
 using drone_protocol::Command;
