@@ -11,7 +11,9 @@ from .source import INVALID, Node
 
 T = TypeVar("T")
 
-_BAD_TEXT = re.compile(r"[\x00-\x1f\x7f\\]|\?\?|\"\"\"")
+# what would break out of a string or comment of a target: controls, a backslash, a trigraph, a docstring's end, and
+# a block comment's ends (the C and TypeScript targets print descriptions inside /* */)
+_BAD_TEXT = re.compile(r"[\x00-\x1f\x7f\\]|\?\?|\"\"\"|/\*|\*/")
 MAX_TEXT = 2000  # characters of one text value: a paragraph (and wrapping it stays instant)
 
 
@@ -53,7 +55,7 @@ class Reader:
         if isinstance(value, str) and kind is str:
             problem = text_problem(value)
             if problem:
-                self.error(node, problem, "write plain text; it is printed into C++ and Python code",
+                self.error(node, problem, "write plain text; it is printed into the code of every target",
                            path=self.sub(key))
                 return default
         return value  # type: ignore[return-value]  # isinstance(value, kind) was checked above

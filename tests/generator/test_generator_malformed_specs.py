@@ -45,7 +45,7 @@ def line_of(anchor: str, *edits: tuple[str, str]) -> int:
 
 
 IDENT_HINT = "(hint: names become Python and C++ identifiers)"
-TEXT_HINT = "(hint: write plain text; it is printed into C++ and Python code)"
+TEXT_HINT = "(hint: write plain text; it is printed into the code of every target)"
 NO_RANGE = ("field 'angle' has no range and the direction drives no channel "
             "(hint: give the field a range or the direction a channel)")
 SERVO_MOVES = (("u", "      u:\n        ^name: up\n        description: Up\n"),
@@ -203,6 +203,12 @@ CASES = [
     Case("text with a trigraph", ((STRAFE, "        description: Strafe left??/"),),
          (("Strafe left??/", "categories.m.directions.l.description: text contains '??', which could break out of "
            f"a comment or string in generated code {TEXT_HINT}"),)),
+    Case("text that ends a block comment", ((STRAFE, "        description: Strafe left */ int x;"),),
+         (("Strafe left */", "categories.m.directions.l.description: text contains '*/', which could break out of a "
+           f"comment or string in generated code {TEXT_HINT}"),)),
+    Case("text that opens a block comment", ((STRAFE, "        description: Strafe /* left"),),
+         (("Strafe /*", "categories.m.directions.l.description: text contains '/*', which could break out of a "
+           f"comment or string in generated code {TEXT_HINT}"),)),
     Case("text with a control character", ((STRAFE, '        description: "Strafe\\x01left"'),),
          (('"Strafe', "categories.m.directions.l.description: text contains '\\x01', which could break out of a "
            f"comment or string in generated code {TEXT_HINT}"),)),
