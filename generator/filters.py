@@ -95,6 +95,12 @@ def frame_text(frame: bytes) -> str:
     return "".join(chr(b) if 0x20 <= b < 0x7F else f"\\x{b:02x}" for b in frame)
 
 
+def block_comment(text: str) -> str:
+    """Text for a C or JSDoc block comment: a frame's codes may be `*` then `/` (the comment would end) or `/`
+    then `*` (GCC's -Wcomment); each gets the backslash JSDoc uses, shown as is in C."""
+    return text.replace("*/", "*\\/").replace("/*", "/\\*")
+
+
 def wrap(text: str, width: int = 100, prefix: str = "") -> str:
     """Text wrapped to `width` columns, every line after the first starting with `prefix`."""
     return textwrap.fill(text, width=width, subsequent_indent=prefix, break_on_hyphens=False)
@@ -117,6 +123,7 @@ ALL: dict[str, Callable[..., Any]] = {
     "upper": str.upper,
     "frame_text": frame_text,
     "wrap": wrap,
+    "block_comment": block_comment,
     "tojson": lambda v: json.dumps(v, sort_keys=True),
     "add_suffix": lambda text, suffix: f"{text}{suffix}",
 }
