@@ -7,7 +7,7 @@ from __future__ import annotations
 from .ardupilot import FS_THR_RANGE_US, STICKS, THR_DZ_DEFAULT, THR_DZ_RANGE, fs_thr_value, mode_slot
 from .errors import SpecError
 from .model import Channel, FlightControllerSetup, Project, WiredPin, Wiring
-from .reader import Reader, is_int
+from .reader import Reader, is_int, kind_name
 from .source import Node
 
 PIN_RANGE = (2, 19)  # digital pins of an Uno (A0-A5 are 14-19); 0 and 1 are the USB serial port
@@ -36,7 +36,10 @@ def flight_controller(top: Reader, channels: dict[str, Channel]) -> FlightContro
         if not isinstance(listed.value, list):
             r.error(listed, f"expected a list of channel names, found {listed.value!r}", path=r.sub("reversed"))
         for item in listed.items:
-            if item.value not in channels or item.value in names:
+            if not isinstance(item.value, str):
+                r.error(item, f"expected a channel name, found {kind_name(item.value)}",
+                        "known: " + ", ".join(channels), path=r.sub("reversed"))
+            elif item.value not in channels or item.value in names:
                 what = "listed twice" if item.value in names else "is not a channel"
                 r.error(item, f"'{item.value}' {what}", "known: " + ", ".join(channels), path=r.sub("reversed"))
             else:

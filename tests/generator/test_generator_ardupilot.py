@@ -163,6 +163,8 @@ def test_without_a_flight_controller_section_the_parameters_keep_arducopters_def
     (("reversed: [pitch]", "reversed: [pitch, wings]"), "flight_controller.reversed: 'wings' is not a channel"),
     (("reversed: [pitch]", "reversed: [pitch, pitch]"), "flight_controller.reversed: 'pitch' listed twice"),
     (("reversed: [pitch]", "reversed: pitch"), "flight_controller.reversed: expected a list of channel names"),
+    (("reversed: [pitch]", "reversed: [[pitch], {yaw: 1}]"),  # found by mutating the spec: it raised a TypeError
+     "flight_controller.reversed: expected a channel name, found a list"),
     (("throttle_dead_band: 10", "throttle_dead_band: 301"),
      "flight_controller.throttle_dead_band: throttle_dead_band 301 is not in 0..300"),
     (("throttle_dead_band: 10", "throttle_dead_bnd: 10"), "flight_controller.throttle_dead_bnd: unknown key"),
