@@ -237,6 +237,10 @@ def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
                 raise ConfigError(
                     f"{where}: option 'hsv.ranges[{i}]' {name} {triple} out of range (H 0..179, S,V 0..255)"
                 )
+        for channel, low, high in zip("HSV", lo, hi, strict=True):
+            if low > high:  # inRange would match nothing: the detector would never see the target
+                wraps = " (a hue range across 179 is two ranges: [174..179] and [0..6])" if channel == "H" else ""
+                raise ConfigError(f"{where}: option 'hsv.ranges[{i}]' low {lo} is above high {hi} in {channel}{wraps}")
     if not config.hsv.ranges:
         raise ConfigError(f"{where}: option 'hsv.ranges' must hold at least one range")
     _validate_vision(config, where)

@@ -41,6 +41,10 @@ def test_config_round_trip(tmp_path: Path) -> None:
         ("detector: sonar\n", "option 'detector' must be one of"),
         ("hsv:\n  ranges: [[[0, 0, 0], [200, 255, 255]]]\n", "option 'hsv.ranges[0]'"),
         ("hsv:\n  ranges: [[[0, 0], [10, 255, 255]]]\n", "option 'hsv.ranges[0][0]' must have 3 items"),
+        # an inverted range matched nothing, and an inverted hue range raised a ValueError building the detector
+        ("hsv:\n  ranges: [[[174, 120, 70], [6, 255, 255]]]\n", "option 'hsv.ranges[0]' low (174, 120, 70) is above "
+         "high (6, 255, 255) in H (a hue range across 179 is two ranges"),
+        ("hsv:\n  ranges: [[[0, 200, 70], [6, 120, 255]]]\n", "option 'hsv.ranges[0]' low (0, 200, 70) is above high"),
         ("controller:\n  retreat_size: 0.5\n", "option 'controller.retreat_size'"),
         ("controller:\n  back_off_size: 0.1\n", "option 'controller.back_off_size'"),
         ("link: 5\n", "option 'link' must be a mapping"),
