@@ -122,6 +122,7 @@ def _check_args(args: argparse.Namespace) -> None:
         ("--gusts", args.gusts, 0.0 <= args.gusts <= 20.0, "within 0..20"),
         ("--readout-ms", args.readout_ms, 0.0 <= args.readout_ms <= 1000.0, "within 0..1000"),
         ("--baud", args.baud, 0 < args.baud <= 4_000_000, "within 1..4000000"),
+        ("--seed", args.seed, args.seed >= 0, "0 or more"),  # numpy's seed sequences take no negative number
     )
     for option, value, ok, allowed in checks:
         if not ok:  # NaN fails every comparison, infinities the upper bounds

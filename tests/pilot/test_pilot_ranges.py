@@ -66,6 +66,7 @@ def test_land_time_must_fit_the_firmware_landing_and_disarm() -> None:
         (["--baud", "0"], "--baud"),
         (["--readout-ms", "nan"], "--readout-ms"),
         (["--readout-ms", "-5"], "--readout-ms"),
+        (["--seed", "-1"], "--seed"),  # raised numpy's ValueError from inside the simulator
         (["--size", "100000x100000"], "--size"),
         (["--size", "4097x240"], "--size"),
         (["--size", "16x16"], "--size"),
