@@ -68,7 +68,13 @@ def main(argv: list[str] | None = None) -> int:
             return EXIT_STALE
         print(f"{len(files)} generated files match {shown} (fingerprint {spec.short_fingerprint})")
         return 0
-    changed = write_atomically(files, opts.out)
+    try:
+        changed = write_atomically(files, opts.out)
+    except OSError as exc:  # a folder that cannot be made or written: a usage error, as argparse's are
+        where = display_path(Path(exc.filename)) if exc.filename else display_path(opts.out)
+        print(f"{parser.prog}: error: --out {display_path(opts.out)}: cannot write {where}: {exc.strerror}; "
+              "no file was written", file=sys.stderr)
+        return EXIT_INVALID
     print(f"{len(files)} files from {shown} (fingerprint {spec.short_fingerprint}) in {display_path(opts.out)}/: "
           f"{len(changed)} changed")
     return 0

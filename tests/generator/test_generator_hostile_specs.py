@@ -264,6 +264,16 @@ def test_a_spec_that_is_not_a_file_is_a_located_error_and_never_blocks(kind: str
     assert not (tmp_path / "out").exists()
 
 
+def test_an_output_folder_that_cannot_be_made_is_one_line_naming_it(tmp_path: Path) -> None:
+    (tmp_path / "file").write_text("not a folder")
+    out = tmp_path / "file" / "out"
+    proc = cli(h.SPEC, out)  # raised NotADirectoryError with a traceback
+    stderr = proc.stderr.decode()
+    assert proc.returncode == 2 and "Traceback" not in stderr and stderr.count("\n") == 1, stderr
+    assert stderr.startswith(f"python -m generator: error: --out {out}: cannot write ")
+    assert stderr.rstrip().endswith("no file was written")
+
+
 HOSTILE_NAMES = ["x --><img src=x onerror=alert(1)><!--.yaml", "a\n#define static_assert(x) x\n.yaml",
                  'q"; import os; "*.yaml', "\u202edrone.yaml", "a'b`c$(d).yaml"]
 
