@@ -153,6 +153,7 @@ export function checkText(bytes: ArrayLike<number>, length = bytes.length): stri
 
 /** Decode exactly one frame; throw a ProtocolError naming the first bad byte and what was allowed there. */
 export function decode(frame: ArrayLike<number>): Command {
+  requireBytes(frame, "decode()");
   const length = frame.length;
   if (length !== WIRE_LENGTH) {
     if (length < WIRE_LENGTH) throw new ProtocolError("too_short", `frame has ${length} bytes, expected ${WIRE_LENGTH}`, length);
@@ -192,6 +193,22 @@ export function decode(frame: ArrayLike<number>): Command {
     throw new ProtocolError("out_of_range", `value ${value} of ${spec.name} is outside ${spec.minimum}..${spec.maximum} ${spec.unit}`, 2);
   }
   return { name: spec.name, category: spec.category, direction: spec.direction, value };
+}
+
+/**
+ * Throw a TypeError unless `value` is bytes: TypeScript's types refuse anything else, JavaScript's do not (a string
+ * or an ArrayBuffer would otherwise read as a frame of the wrong length or of wrong bytes).
+ */
+export function requireBytes(value: unknown, where: string, takes = "bytes (a Uint8Array or an array of numbers)"): void {
+  if (typeof value !== "object" || value === null || typeof (value as { length?: unknown }).length !== "number") {
+    throw new TypeError(`${where} takes ${takes}, not ${kindOf(value)}`);
+  }
+}
+
+function kindOf(value: unknown): string {
+  if (value === null || value === undefined) return String(value);
+  if (typeof value === "object") return value.constructor?.name ?? "an object";
+  return typeof value === "string" ? "a string" : typeof value;
 }
 
 function show(byte: number): string {

@@ -4,7 +4,7 @@
 
 // The Arduino's reply lines (one ASCII line each, ending in "\n"): parseReply() and the writers.
 
-import { type Command, ProtocolError, checkText, lookup } from "./codec.js";
+import { type Command, ProtocolError, checkText, lookup, requireBytes } from "./codec.js";
 import {
   CHECK_LENGTH, ERRORS, INTEGRITY, LASER_OFF, LASER_ON, PROTOCOL_NAME, REPLIES, SPEC_FINGERPRINT, STATES,
   STATUS_SEPARATOR, type Category, type CommandName, type Direction, type ErrorName, type StateName,
@@ -56,6 +56,7 @@ const PREFIXES = (Object.keys(REPLIES) as (keyof typeof REPLIES)[])
  * the line's crc8 check is missing or wrong.
  */
 export function parseReply(line: string | ArrayLike<number>): Reply {
+  if (typeof line !== "string") requireBytes(line, "parseReply()", "a line (a string, or its bytes)");
   let text = typeof line === "string" ? line : ascii(line);
   text = text.replace(/[\r\n]+$/, "");
   if (CHECK_LENGTH > 0) {

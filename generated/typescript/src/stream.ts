@@ -4,7 +4,7 @@
 
 // The byte-at-a-time stream parser, with the same rules as the Arduino's StreamParser.
 
-import { type Command, type CommandEntry, checkText, isCategory, lookup } from "./codec.js";
+import { type Command, type CommandEntry, checkText, isCategory, lookup, requireBytes } from "./codec.js";
 import { ERRORS, FRAME_LENGTH, INTER_BYTE_TIMEOUT_MS, WIRE_LENGTH, type ErrorName } from "./spec.js";
 
 const KINDS = Object.keys(ERRORS) as ErrorName[];
@@ -32,6 +32,11 @@ export class StreamParser {
    * frame, else null.
    */
   feed(byte: number, nowMs: number): Command | null {
+    if (typeof byte !== "number" || !Number.isFinite(nowMs)) {  // JavaScript callers: `byte & 0xff` of a chunk is 0
+      throw new TypeError(typeof byte !== "number"
+        ? `StreamParser.feed() takes one byte (a number), not ${typeof byte}: feedAll() takes a Uint8Array`
+        : `StreamParser.feed() needs the time in whole milliseconds, e.g. Math.floor(performance.now()), not ${nowMs}`);
+    }
     this.first = null;
     if (this.length > 0 && (nowMs - this.lastMs) >>> 0 > INTER_BYTE_TIMEOUT_MS) {
       this.count("timeout");
@@ -44,6 +49,7 @@ export class StreamParser {
 
   /** Feed bytes that arrived together at `nowMs`; returns the commands they complete, in order. */
   feedAll(bytes: ArrayLike<number>, nowMs: number): Command[] {
+    requireBytes(bytes, "StreamParser.feedAll()");
     const out: Command[] = [];
     for (let i = 0; i < bytes.length; i++) {
       const command = this.feed(bytes[i] ?? 0, nowMs);
