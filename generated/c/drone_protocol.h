@@ -5,6 +5,8 @@
 //
 // C99 codec for any MCU or Linux program that is not an Arduino sketch: no heap, no stdio, no dependencies
 // beyond <stdbool.h>, <stddef.h> and <stdint.h>. Every name starts with dp_ / DP_.
+// Pointer arguments must not be NULL, as for memcpy: no function checks them (a NULL frame is a crash, not an
+// error code).
 //
 //   dp_stream_parser parser = DP_STREAM_PARSER_INIT;
 //   dp_command command;
