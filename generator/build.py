@@ -31,6 +31,7 @@ FRAME_ERRORS = tuple(e for e in PARSER_ERRORS if e != "timeout")
 # Refusals the generated dispatch (unsupported), the integrity check (bad_check) and the firmware reply with.
 REFUSALS = ("unsupported", "bad_check", "not_armed", "busy", "armed", "airborne")
 REPLIES = ("ready", "accepted", "rejected", "failsafe")
+MAX_DIGITS = 4  # value digits of a frame: 16-bit values on the Arduino (a frame is category, direction, digits)
 
 
 def fingerprint(value: object) -> str:
@@ -88,8 +89,8 @@ class _Builder(CommandsBuilder):
         if encoding is not None and encoding != "ascii":
             frame.error(frame.node.children["encoding"], f"unsupported encoding '{encoding}'", "only ascii",
                         frame.sub("encoding"))
-        if is_int(frame.node.children.get("length")) and not 3 <= length <= 6:
-            frame.error(frame.node.children["length"], f"frame length {length} is not in 3..6",
+        if is_int(frame.node.children.get("length")) and not 3 <= length <= MAX_DIGITS + 2:
+            frame.error(frame.node.children["length"], f"frame length {length} is not in 3..{MAX_DIGITS + 2}",
                         "a frame is category, direction and 1 to 4 value digits (16-bit values on the Arduino)",
                         frame.sub("length"))
         inter_byte = self._positive(frame, "inter_byte_timeout_ms")
@@ -272,6 +273,11 @@ class _Builder(CommandsBuilder):
         fields: dict[str, tuple[Field, tuple[int, int] | None, int | None, Node]] = {}
         for name, r in self._named_entries(top, "fields"):
             width = r.integer("width")
+            if not 1 <= width <= MAX_DIGITS:  # checked first: 10 ** width of a hostile width would never finish
+                if is_int(r.node.children.get("width")):
+                    r.error(r.node.children["width"], f"width {width} is not in 1..{MAX_DIGITS}",
+                            "a value is 1 to 4 digits (16-bit values on the Arduino)", r.sub("width"))
+                width = 0  # no width: the checks that need one are skipped
             unit = r.text("unit")
             description = r.text("description")
             pair = self._pair(r, "range") if r.node.children.get("range") is not None else None

@@ -161,7 +161,7 @@ class CommandsBuilder:
                 r.error(default_node, f"expected an integer or low/median/high, found {value!r}",
                         path=r.sub("default"))
                 return None
-        if pair[1] >= 10 ** fld.width:
+        if fld.width and pair[1] >= 10 ** fld.width:  # no width: its own error is reported
             r.error(r.node, f"range {pair[0]}..{pair[1]} does not fit in {fld.width} digits", path=path)
             return None
         if default is not None and not pair[0] <= default <= pair[1]:

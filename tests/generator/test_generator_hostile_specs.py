@@ -191,6 +191,9 @@ CASES = [
                    ("  rc_inputs:\n", "  rc_inputs:\n    aux: 7\n")),
             (("  aux:\n    recorded: ^[",
               "channels.aux.recorded: AUX_MAX = 70000 does not fit its C++ type uint16_t"),)),
+    # 10 ** width was computed before the width was bounded: a spec mutation's width of 2**31 - 1 never finished
+    Hostile("a field width of 2**31 - 1", edited(("  speed:\n    width: 4", "  speed:\n    width: 2147483647")),
+            (("width: ^2147483647", "fields.speed.width: width 2147483647 is not in 1..4"),)),
     Hostile("a reply prefix that overflows REPLY_MAX_LENGTH",
             edited(('prefix: "#READY"', 'prefix: "#' + "R" * 240 + '"')),
             (("replies:\n  ^ready", "replies: REPLY_MAX_LENGTH = "),)),
