@@ -4,7 +4,14 @@ from __future__ import annotations
 
 import sys
 
-from .cli import main
+from .protocol_needs import missing_name
 
 if __name__ == "__main__":
+    try:
+        from .cli import main
+    except AttributeError:  # a module of the pilot read, as it was imported, a protocol name the spec lost
+        if (problem := missing_name()) is None:
+            raise
+        print(f"pilot: error: {problem}", file=sys.stderr)
+        sys.exit(2)
     sys.exit(main())
