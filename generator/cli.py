@@ -13,7 +13,7 @@ from pathlib import Path
 
 from . import __version__
 from .build import load_spec
-from .diff import Contract, contract, diff
+from .diff import Contract, contract, contract_problem, diff
 from .errors import SpecInvalid
 from .source import display_path
 
@@ -48,7 +48,13 @@ def main(argv: list[str] | None = None) -> int:
         opts.spec = DEFAULT_SPEC
     shown = display_path(opts.spec)
     try:
-        spec = load_spec(opts.spec, previous=_previous_contract(opts.out / CONTRACT_FILE))
+        previous = None if opts.version else _previous_contract(opts.out / CONTRACT_FILE)
+        spec = load_spec(opts.spec, previous=previous)
+    except BrokenContract as exc:
+        print(f"{parser.prog}: error: {exc}; restore it (git checkout {display_path(opts.out / CONTRACT_FILE)}) or "
+              "delete it to generate without the check that a breaking edit raised protocol.version; nothing was "
+              "written", file=sys.stderr)
+        return EXIT_INVALID
     except SpecInvalid as exc:
         _report(shown, exc)
         return EXIT_INVALID
@@ -90,6 +96,9 @@ def diff_main(argv: list[str]) -> int:
     opts = parser.parse_args(argv)
     try:
         old, new = _contract_of(opts.old), _contract_of(opts.new)
+    except BrokenContract as exc:
+        print(f"{parser.prog}: error: {exc}", file=sys.stderr)
+        return EXIT_INVALID
     except SpecInvalid as exc:
         _report(display_path(exc.errors[0].location.file) if exc.errors else "spec", exc)
         return EXIT_INVALID
@@ -112,14 +121,27 @@ def _report(shown: str, exc: SpecInvalid) -> None:
         print(error, file=sys.stderr)
 
 
+class BrokenContract(Exception):
+    """A contract.json that is there but unreadable: the version check it feeds would be skipped unseen."""
+
+
 def _previous_contract(file: Path) -> Contract | None:
-    """The contract in a generated contract.json, if it is there and readable (else there is nothing to compare)."""
+    """The contract in a generated contract.json; None if there is no such file or it holds no contract (another
+    tool's JSON). Raises BrokenContract if it does not parse or is not the shape the generator writes."""
     try:
         data = json.loads(file.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except OSError:
         return None
+    except ValueError as exc:  # not UTF-8 or not JSON: a merge's conflict markers, a hand edit
+        raise BrokenContract(f"{display_path(file)} is not valid JSON ({exc})") from exc
     found = data.get("contract") if isinstance(data, dict) else None
-    return found if isinstance(found, dict) and isinstance(found.get("version"), int) else None
+    if found is None:
+        return None
+    problem = contract_problem(found)
+    if problem is not None:
+        raise BrokenContract(f"{display_path(file)} is not a contract the generator wrote: {problem}")
+    checked: Contract = found
+    return checked
 
 
 def _contract_of(path: Path) -> Contract:

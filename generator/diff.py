@@ -48,6 +48,35 @@ def contract(spec: Spec) -> Contract:
     }
 
 
+# What each entry of a contract's tables holds, as `contract` writes it: the keys `diff` reads, and their types.
+_ENTRIES: dict[str, dict[str, tuple[type, ...]]] = {
+    "commands": {"name": (str,), "min": (int,), "max": (int,), "default": (int, type(None)), "target": (str,),
+                 "sense": (int,), "routine": (str, type(None)), "unit": (str,), "description": (str,)},
+    "errors": {}, "replies": {}, "states": {},  # read with .get(): any mapping will do
+}
+
+
+def contract_problem(found: object) -> str | None:
+    """Why `found` is not a contract as `contract` writes it (a hand edit, a bad merge), or None. A section or table
+    may be missing: a contract written before it existed."""
+    if not isinstance(found, dict):
+        return "it is not a mapping"
+    if not isinstance(found.get("name"), str) or type(found.get("version")) is not int:
+        return "its name or its integer version is missing"
+    for section in ("frame", "link", "status", "timing", "texts", *_ENTRIES):
+        if not isinstance(found.get(section, {}), dict):
+            return f"{section} is not a mapping"
+    for table, keys in _ENTRIES.items():
+        for code, entry in found.get(table, {}).items():
+            if not isinstance(entry, dict):
+                return f"{table}.{code} is not a mapping"
+            for key, kinds in keys.items():
+                value = entry.get(key, ...)
+                if not isinstance(value, kinds) or (isinstance(value, bool) and bool not in kinds):
+                    return f"{table}.{code}.{key} is missing or not {' or '.join(k.__name__ for k in kinds)}"
+    return None
+
+
 @dataclass(frozen=True)
 class Change:
     breaking: bool

@@ -136,3 +136,26 @@ def test_another_protocol_in_the_output_folder_is_not_a_previous_version(tmp_pat
     other = spec_file(tmp_path, "other.yaml", ("  name: drone_protocol", "  name: rover_protocol"),
                       ("  baud: 115200", "  baud: 9600"))
     assert h.generate("--spec", other, "--out", out).code == 0
+
+
+# A contract.json edited by hand or by a bad merge: each raised a TypeError or KeyError inside the comparison.
+BROKEN = [("<<<<<<< HEAD\n", "is not valid JSON"),
+          ('{"contract": {"name": "drone_protocol", "version": 1, "commands": 5}}', "commands is not a mapping"),
+          ('{"contract": {"name": "drone_protocol", "version": 1, "commands": {"mf": {"name": "move_forward"}}}}',
+           "commands.mf.min is missing or not int"),
+          ('{"contract": {"name": "drone_protocol", "version": "1"}}', "its name or its integer version is missing")]
+
+
+@pytest.mark.parametrize(("text", "problem"), BROKEN, ids=["conflict markers", "a number for a table",
+                                                           "an entry without its range", "a text version"])
+def test_a_broken_contract_is_one_line_naming_it_and_nothing_is_written(tmp_path: Path, text: str,
+                                                                        problem: str) -> None:
+    out = generated_copy(tmp_path)
+    (out / "contract.json").write_text(text, encoding="utf-8")
+    before = h.tree(out)
+    for args in (("--spec", h.FIXTURE, "--out", out), ("--spec", h.FIXTURE, "--out", out, "--check"),
+                 ("diff", out / "contract.json", h.FIXTURE)):
+        run = h.generate(*args)
+        assert run.code == 2 and run.stderr.count("\n") == 1 and "Traceback" not in run.stderr, run.stderr
+        assert f"error: {out / 'contract.json'} " in run.stderr and problem in run.stderr, run.stderr
+    assert h.tree(out) == before
