@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import sys
 
-from .protocol_needs import missing_name
+from .protocol_needs import protocol_problem
 
 if __name__ == "__main__":
     try:
         from .cli import main
     except AttributeError:  # a module of the pilot read, as it was imported, a protocol name the spec lost
-        if (problem := missing_name()) is None:
+        if (problem := protocol_problem()) is None:
             raise
         print(f"pilot: error: {problem}", file=sys.stderr)
         sys.exit(2)

@@ -31,7 +31,7 @@ from .errors import PilotError
 from .link import Link, LogEntry, keepalive_ms
 from .observers import LaserTally
 from .picam import PicameraSource
-from .protocol_needs import missing_name
+from .protocol_needs import protocol_problem
 from .record import Recorder
 from .runner import DryRunSink, Observer, RealPacer, Sink, StatusLine, run
 
@@ -338,7 +338,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             cfg = calibrate_to_config(args.calibrate, args.config, _roi(args.roi))
             print(f"pilot: saved HSV ranges {cfg.hsv.ranges} to {args.config}; preview {preview_path(args.config)}")
             return EXIT_OK
-        if (problem := missing_name()) is not None:  # a spec edit the pilot cannot fly with
+        if (problem := protocol_problem()) is not None:  # a spec edit the pilot cannot fly with
             raise PilotError(problem)
         check_sources(args)
         _check_args(args)

@@ -30,7 +30,7 @@ def _read_every_name() -> None:
     )
 
 
-def missing_name() -> str | None:
+def protocol_problem() -> str | None:
     """Why the pilot cannot start with this ``drone_protocol``, or None when it has every name the pilot uses."""
     try:
         _read_every_name()

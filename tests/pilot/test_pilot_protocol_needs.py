@@ -41,7 +41,7 @@ def test_the_start_up_check_reads_every_protocol_name_the_pilot_uses() -> None:
     function = next(n for n in ast.walk(ast.parse(source))
                     if isinstance(n, ast.FunctionDef) and n.name == "_read_every_name")
     assert used == dp_names([function]), "pilot/protocol_needs.py's list differs from the names the pilot reads"
-    assert protocol_needs.missing_name() is None
+    assert protocol_needs.protocol_problem() is None
 
 
 def _drop_land(spec: dict[str, Any]) -> None:
