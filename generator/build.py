@@ -91,8 +91,8 @@ class _Builder(CommandsBuilder):
                         frame.sub("encoding"))
         if is_int(frame.node.children.get("length")) and not 3 <= length <= MAX_DIGITS + 2:
             frame.error(frame.node.children["length"], f"frame length {length} is not in 3..{MAX_DIGITS + 2}",
-                        "a frame is category, direction and 1 to 4 value digits (16-bit values on the Arduino)",
-                        frame.sub("length"))
+                        f"a frame is category, direction and 1 to {MAX_DIGITS} value digits (16-bit values on the "
+                        "Arduino)", frame.sub("length"))
         inter_byte = self._positive(frame, "inter_byte_timeout_ms")
         integrity = frame.text("integrity", "none")
         if integrity not in INTEGRITY_MODES:
@@ -276,7 +276,7 @@ class _Builder(CommandsBuilder):
             if not 1 <= width <= MAX_DIGITS:  # checked first: 10 ** width of a hostile width would never finish
                 if is_int(r.node.children.get("width")):
                     r.error(r.node.children["width"], f"width {width} is not in 1..{MAX_DIGITS}",
-                            "a value is 1 to 4 digits (16-bit values on the Arduino)", r.sub("width"))
+                            f"a value is 1 to {MAX_DIGITS} digits (16-bit values on the Arduino)", r.sub("width"))
                 width = 0  # no width: the checks that need one are skipped
             unit = r.text("unit")
             description = r.text("description")
