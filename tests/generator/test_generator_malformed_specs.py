@@ -45,6 +45,7 @@ def line_of(anchor: str, *edits: tuple[str, str]) -> int:
 
 
 IDENT_HINT = "(hint: names become Python and C++ identifiers)"
+LINK_8N1 = "is not supported: the firmware and the pilot run 8 data bits, no parity, 1 stop bit"
 TEXT_HINT = "(hint: write plain text; it is printed into the code of every target)"
 NO_RANGE = ("field 'angle' has no range and the direction drives no channel "
             "(hint: give the field a range or the direction a channel)")
@@ -212,6 +213,13 @@ CASES = [
     Case("text with a control character", ((STRAFE, '        description: "Strafe\\x01left"'),),
          (('"Strafe', "categories.m.directions.l.description: text contains '\\x01', which could break out of a "
            f"comment or string in generated code {TEXT_HINT}"),)),
+    # -- the link: the firmware's UART and the pilot's port run 8N1 only ----------------------------------------
+    Case("seven data bits", (("  data_bits: 8", "  data_bits: 7"),),
+         (("7\n  parity", f"link.data_bits: data_bits 7 {LINK_8N1} (hint: write 8 (8N1))"),)),
+    Case("even parity", (("  parity: none", "  parity: even"),),
+         (("even\n  stop_bits", f"link.parity: parity even {LINK_8N1} (hint: write none (8N1))"),)),
+    Case("two stop bits", (("  stop_bits: 1", "  stop_bits: 2"),),
+         (("2\n  # Opening", f"link.stop_bits: stop_bits 2 {LINK_8N1} (hint: write 1 (8N1))"),)),
     # -- YAML itself -------------------------------------------------------------------------------------------
     Case("YAML syntax error", ((STRAFE, "        description: [Strafe left"),),
          (("[Strafe left\n        channel^:", "YAML syntax error: expected ',' or ']', but got ':'"),)),
