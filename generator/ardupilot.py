@@ -15,6 +15,7 @@ MODE_SLOT_BOUNDS_US = (1230, 1360, 1490, 1620, 1749)
 MODE_NUMBERS = {"stabilize": 0, "alt_hold": 2}  # ArduCopter's mode numbers: Stabilize 0, AltHold 2
 FS_THR_LAND = 3  # FS_THR_ENABLE: 1 = RTL (climbs to RTL_ALT: never indoors), 3 = always Land
 FS_THR_RANGE_US = (910, 1100)  # the range ArduPilot documents for FS_THR_VALUE
+RC_RANGE_US = (800, 2200)  # the range ArduPilot documents for RCn_MIN and RCn_MAX: the pulses it reads as sticks
 STICKS = ("roll", "pitch", "throttle", "yaw")  # the channels RCMAP_* places
 THR_DZ_DEFAULT = 100  # ArduCopter's THR_DZ when the spec says nothing
 THR_DZ_RANGE = (0, 300)  # the range ArduPilot documents for THR_DZ

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TypeVar
 
 from . import __version__, hardware
+from .ardupilot import RC_RANGE_US
 from .build_commands import CommandsBuilder
 from .diff import Contract, contract, version_problem
 from .errors import SpecError, SpecInvalid
@@ -257,6 +258,11 @@ class _Builder(CommandsBuilder):
             if pair is None:
                 continue
             lo, hi = pair
+            low, high = RC_RANGE_US
+            if not (low <= lo and hi <= high) and hi <= 0xFFFF:  # past uint16_t: widths.py's error says so
+                r.error(r.node.children["recorded"], f"recorded [{lo}, {hi}] is outside {low}..{high} us",
+                        "ArduPilot's RCn_MIN and RCn_MAX range: the flight controller reads no stick outside it",
+                        r.sub("recorded"))
             median = (lo + hi + 1) // 2  # midpoint rounded half up
             channels[name] = Channel(name, lo, hi, median, median - step, median + step, movement)
         return channels

@@ -46,6 +46,7 @@ def line_of(anchor: str, *edits: tuple[str, str]) -> int:
 
 IDENT_HINT = "(hint: names become Python and C++ identifiers)"
 LINK_8N1 = "is not supported: the firmware and the pilot run 8 data bits, no parity, 1 stop bit"
+RC_HINT = "(hint: ArduPilot's RCn_MIN and RCn_MAX range: the flight controller reads no stick outside it)"
 TEXT_HINT = "(hint: write plain text; it is printed into the code of every target)"
 NO_RANGE = ("field 'angle' has no range and the direction drives no channel "
             "(hint: give the field a range or the direction a channel)")
@@ -129,10 +130,14 @@ CASES = [
           *((a, f"categories.s.directions.{d}: range 1..18000 does not fit in 4 digits") for d, a in SERVO_MOVES))),
     Case("recorded channel extremes not fitting the width",
          (("    recorded: [1035, 2012]", "    recorded: [1035, 12012]"),),
-         (("      l:\n        ^name: left\n        description: Turn left",
+         (("[1035, 12012]", f"channels.yaw.recorded: recorded [1035, 12012] is outside 800..2200 us {RC_HINT}"),
+          ("      l:\n        ^name: left\n        description: Turn left",
            "categories.t.directions.l: range 1035..12012 does not fit in 4 digits"),
           ("      r:\n        ^name: right\n        description: Turn right",
            "categories.t.directions.r: range 1035..12012 does not fit in 4 digits"))),
+    Case("recorded extremes outside ArduPilot's RC range", (("    recorded: [1000, 2000]\n    movement: Strafe",
+                                                             "    recorded: [18, 255]\n    movement: Strafe"),),
+         (("[18, 255]", f"channels.roll.recorded: recorded [18, 255] is outside 800..2200 us {RC_HINT}"),)),
     Case("default outside the range", ((PITCH_HIGH,
                                         "        channel: pitch\n        default: 2500"),),
          (("2500", "categories.m.directions.f.default: default 2500 is outside range 1000..2000"),)),
