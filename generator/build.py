@@ -32,6 +32,7 @@ FRAME_ERRORS = tuple(e for e in PARSER_ERRORS if e != "timeout")
 # Refusals the generated dispatch (unsupported), the integrity check (bad_check) and the firmware reply with.
 REFUSALS = ("unsupported", "bad_check", "not_armed", "busy", "armed", "airborne")
 REPLIES = ("ready", "accepted", "rejected", "failsafe")
+SERVO_FULL_SCALE_DEG = 180  # a hobby servo's full travel, as the Arduino Servo library and the firmware map it
 MAX_DIGITS = 4  # value digits of a frame: 16-bit values on the Arduino (a frame is category, direction, digits)
 
 
@@ -276,6 +277,10 @@ class _Builder(CommandsBuilder):
             r.finish()
             if pair is None:
                 continue
+            if SERVO_FULL_SCALE_DEG < pair[1] <= 0xFF:  # past uint8_t: widths.py's error says so
+                r.error(r.node.children["range_deg"], f"maximum {pair[1]} is past {SERVO_FULL_SCALE_DEG} degrees",
+                        f"the firmware maps 0..{SERVO_FULL_SCALE_DEG} degrees onto the Arduino Servo library's "
+                        "pulses: more would drive the servo past its end", r.sub("range_deg"))
             if not pair[0] <= default <= pair[1]:
                 r.error(r.node.children["default_deg"], f"default {default} is outside range {pair[0]}..{pair[1]}",
                         path=r.sub("default_deg"))

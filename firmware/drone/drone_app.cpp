@@ -58,6 +58,11 @@ constexpr bool servo_us_exact_from(uint32_t deg) {
          (servo_us_fast(deg) == servo_us_exact(deg) && servo_us_exact_from(deg + 1));
 }
 static_assert(servo_us_exact_from(0), "servo_us_fast must round like the exact formula");
+// Past the full scale a degree would pulse past SERVO_MAX_US: the generator refuses such a spec, and this refuses a
+// library generated without that check.
+static_assert(drone_protocol::SERVO_PAN_MAX <= pulse_timing::SERVO_FULL_SCALE_DEG &&
+                  drone_protocol::SERVO_TILT_MAX <= pulse_timing::SERVO_FULL_SCALE_DEG,
+              "a servo range past the full scale would pulse past SERVO_MAX_US");
 
 uint16_t servo_us(uint8_t deg) { return servo_us_fast(deg); }
 

@@ -138,6 +138,11 @@ CASES = [
     Case("recorded extremes outside ArduPilot's RC range", (("    recorded: [1000, 2000]\n    movement: Strafe",
                                                              "    recorded: [18, 255]\n    movement: Strafe"),),
          (("[18, 255]", f"channels.roll.recorded: recorded [18, 255] is outside 800..2200 us {RC_HINT}"),)),
+    Case("servo range past 180 degrees", (("    description: Vertical servo carrying the camera and the laser\n"
+                                            "    range_deg: [0, 180]", "    description: Vertical servo carrying the "
+                                            "camera and the laser\n    range_deg: [0, 200]"),),
+         (("[0, 200]", "servos.tilt.range_deg: maximum 200 is past 180 degrees (hint: the firmware maps 0..180 degrees "
+           "onto the Arduino Servo library's pulses: more would drive the servo past its end)"),)),
     Case("default outside the range", ((PITCH_HIGH,
                                         "        channel: pitch\n        default: 2500"),),
          (("2500", "categories.m.directions.f.default: default 2500 is outside range 1000..2000"),)),
