@@ -23,8 +23,15 @@ Ring rx;
 Ring tx;
 
 // Double speed (U2X), as the core sets it: 115200 baud is 117647 at 16 MHz (+2.1 %).
+static_assert(F_CPU / 4 / drone_protocol::BAUD >= 1, "the baud rate is too high for this clock");
 constexpr uint16_t UBRR_SETTING = static_cast<uint16_t>((F_CPU / 4 / drone_protocol::BAUD - 1) / 2);
 static_assert(UBRR_SETTING < 4096, "the baud rate is too low for UBRR0");
+// The rate the UART runs at must be near the spec's, or the Pi reads garbage: 4000000 baud ran at 2000000. 5 %
+// lets 230400 through (222222, -3.5 %), which an Uno's USB bridge, clocked the same, makes the same way.
+constexpr uint32_t ACTUAL_BAUD = F_CPU / 8 / (UBRR_SETTING + 1UL);
+static_assert((ACTUAL_BAUD > drone_protocol::BAUD ? ACTUAL_BAUD - drone_protocol::BAUD
+                                                  : drone_protocol::BAUD - ACTUAL_BAUD) * 100 <= 5 * drone_protocol::BAUD,
+              "this clock cannot make the spec's baud rate within 5 %");
 
 }  // namespace
 
