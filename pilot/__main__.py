@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import sys
 
-from .protocol_needs import protocol_problem
+from .link.protocol_needs import protocol_problem
 
 if __name__ == "__main__":
     try:
-        from .cli import main
+        from .app.cli import main
     except AttributeError:  # a module of the pilot read, as it was imported, a protocol name the spec lost
         if (problem := protocol_problem()) is None:
             raise

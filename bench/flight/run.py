@@ -24,7 +24,7 @@ from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
-from pilot.sim.flight import FlightJob, FlightResult, _fly_job
+from pilot.app.sim_flight import FlightJob, FlightResult, _fly_job
 from pilot.sim.room import SCENARIOS
 
 HERE = Path(__file__).resolve().parent

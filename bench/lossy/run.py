@@ -33,15 +33,15 @@ from typing import Any
 import drone_protocol as dp
 
 from bench.lossy.proxy import LossyProxy
-from pilot.config import PilotConfig
-from pilot.controller import Controller
-from pilot.detect import make_detector
-from pilot.link import Link, keepalive_ms
-from pilot.runner import run
-from pilot.sim.flight import SUCCESS_LIT_MS
+from pilot.app.runner import run
+from pilot.app.sim_flight import SUCCESS_LIT_MS
+from pilot.common.config import PilotConfig
+from pilot.control.controller import Controller
+from pilot.link.serial_link import Link, keepalive_ms
 from pilot.sim.room import SCENARIOS, make_scenario
 from pilot.sim.virtual import Change, Outputs, VirtualDrone
 from pilot.sim.world import BOOT_MS, SimWorld
+from pilot.vision.detect import make_detector
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]

@@ -22,13 +22,13 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from pilot.config import HsvConfig
-from pilot.detect import ArucoMarkerDetector, HsvBlobDetector
-from pilot.runner import Tick
+from pilot.app.runner import Tick
+from pilot.app.sim_flight import fly
+from pilot.common.config import HsvConfig
 from pilot.sim.camera import CameraModel
-from pilot.sim.flight import fly
 from pilot.sim.room import make_scenario
 from pilot.sim.still import StillView
+from pilot.vision.detect import ArucoMarkerDetector, HsvBlobDetector
 
 HERE = Path(__file__).resolve().parent
 

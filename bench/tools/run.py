@@ -28,10 +28,10 @@ from pathlib import Path
 
 import drone_protocol as dp
 
-from pilot.liveview import LiveView
-from pilot.observers import StopSwitch, WallClockPacing
-from pilot.runner import Observer, Tick
-from pilot.sim.flight import fly
+from pilot.app.liveview import LiveView
+from pilot.app.observers import StopSwitch, WallClockPacing
+from pilot.app.runner import Observer, Tick
+from pilot.app.sim_flight import fly
 
 ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent

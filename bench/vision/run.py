@@ -24,9 +24,9 @@ import vision_eval as ve
 import vision_imagery as vi
 import vision_sequences as vs
 
-from pilot.aruco import ArucoMarkerDetector
-from pilot.config import ControllerConfig
-from pilot.hsv import HsvBlobDetector
+from pilot.common.config import ControllerConfig
+from pilot.vision.aruco import ArucoMarkerDetector
+from pilot.vision.hsv.detector import HsvBlobDetector
 
 HERE = Path(__file__).resolve().parent
 ARUCO_CONDITIONS = ("clean", "perspective", "gaussian_blur", "motion_blur", "jpeg", "dim", "noise", "occlusion", "edge")
@@ -168,7 +168,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def full_gain(n: int, threshold: float) -> list[str]:
-    """HSV in a dark room at the camera's full gain (noise 10-20 per channel; pilot/hsv_noise.py), apart from the
+    """HSV in a dark room at the camera's full gain (noise 10-20 per channel; pilot/vision/hsv/noise.py), apart from the
     conditions above: its own views, so theirs stay as they were."""
     rows = ["", "## HSV in a dark room at full gain (no goal)", "",
             "A quarter of the light, brightened 4 times, noise 10-20 per channel (bench/vision/vision_imagery.py's "

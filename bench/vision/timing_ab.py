@@ -31,7 +31,7 @@ import numpy as np
 import vision_imagery as vi
 from run import TIMING_SEED, floor, timing_frames
 
-from pilot.hsv import HsvBlobDetector
+from pilot.vision.hsv.detector import HsvBlobDetector
 
 ORDERS = tuple(itertools.permutations(range(3)))  # floor, before, after
 Detect = Callable[[vi.Image], object]
@@ -49,7 +49,11 @@ def detector_of(root: Path, name: str) -> Detect:
     package = importlib.util.module_from_spec(spec)
     sys.modules[name] = package
     spec.loader.exec_module(package)
-    detector = importlib.import_module(f"{name}.hsv").HsvBlobDetector()
+    try:  # the layered pilot (pilot/vision/hsv/), or a checkout from before it (pilot/hsv.py)
+        module = importlib.import_module(f"{name}.vision.hsv.detector")
+    except ModuleNotFoundError:
+        module = importlib.import_module(f"{name}.hsv")
+    detector = module.HsvBlobDetector()
     candidates: Detect = detector.candidates
     return candidates
 

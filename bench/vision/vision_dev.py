@@ -36,8 +36,8 @@ import numpy as np
 import vision_eval as ve
 import vision_imagery as vi
 
-from pilot.config import ControllerConfig
-from pilot.hsv import HsvBlobDetector
+from pilot.common.config import ControllerConfig
+from pilot.vision.hsv.detector import HsvBlobDetector
 
 OUT = Path("build/vision-dev")
 TARGET_SETS = {"tun": (vi.TUNING, 21), "val": (vi.VALIDATION, 25), "tun2": (vi.TUNING, 31),

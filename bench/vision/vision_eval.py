@@ -19,7 +19,7 @@ import numpy as np
 import vision_imagery as vi
 from cv2.typing import MatLike
 
-from pilot.detection import Candidate
+from pilot.vision.detection import Candidate
 
 Candidates = Callable[[MatLike], list[Candidate]]  # a detector's every candidate in a frame, best first
 

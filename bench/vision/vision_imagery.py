@@ -6,7 +6,7 @@ the ones that need ``pooch`` to download are not used). The split is fixed here,
 was chosen: the detectors are tuned on ``TUNING`` and only reported on ``HELD_OUT``. ``VALIDATION``, the two
 photos in scikit-learn's wheel, came later: scenes red and orange through and through, where the detector
 fired on 4.8 % of empty views; the circle look's checks were then chosen on them and the tuning photos
-(pilot/hsv_circles.py), so they are reported apart, and are not held out. ``BENCH``, the four photographs of an
+(pilot/vision/hsv/circles.py), so they are reported apart, and are not held out. ``BENCH``, the four photographs of an
 electronics bench in avr-libc's manual (Debian's ``avr-libc``, which the firmware build installs: a board with red
 push-buttons, red sockets and red wires), joined last, after every threshold was chosen: held out like ``HELD_OUT``.
 """

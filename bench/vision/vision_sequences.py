@@ -24,10 +24,10 @@ import numpy as np
 import numpy.typing as npt
 import vision_imagery as vi
 
-from pilot.config import ControllerConfig, PilotConfig
-from pilot.detect import make_detector
-from pilot.detection import Detection
-from pilot.gating import Gate
+from pilot.common.config import ControllerConfig, PilotConfig
+from pilot.vision.detect import make_detector
+from pilot.vision.detection import Detection
+from pilot.vision.gating import Gate
 
 TARGET_FRAMES, NEGATIVE_FRAMES = 10, 30  # K and L
 SEQ_CONDITIONS = ("clean", "gaussian_blur", "motion_blur", "jpeg", "dim", "bright", "warm", "noise", "occlusion")

@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import mj
-from .room import Scenario
+from .scenario import Scenario
 
 Image = npt.NDArray[np.uint8]
 FloatArray = npt.NDArray[np.float64]

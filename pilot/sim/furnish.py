@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import room as r
+from . import scenario as r
 
 WALL_TEXTURES = ("brick", "text", "page")
 FLOOR_TEXTURES = ("gravel", "grass", "coins")

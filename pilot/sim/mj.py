@@ -9,7 +9,7 @@ import os
 from types import ModuleType
 from typing import Any
 
-from ..errors import SimulatorError
+from ..common.errors import SimulatorError
 
 Model = Any  # mujoco.MjModel (MuJoCo ships no type stubs)
 Data = Any  # mujoco.MjData

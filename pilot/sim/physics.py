@@ -20,7 +20,7 @@ from . import mj
 from .arducopter import FlightController, Sensors
 from .mixer import Mixer
 from .rc import SimParams
-from .room import Scenario
+from .scenario import Scenario
 from .scene import HIDDEN_GROUP
 
 FloatArray = npt.NDArray[np.float64]

@@ -18,7 +18,7 @@ from typing import Any
 import drone_protocol as dp
 import yaml
 
-from ..errors import ConfigError
+from ..common.errors import ConfigError
 
 HERE = Path(__file__).resolve().parent
 PARAMS_YAML = HERE / "arducopter.yaml"

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from . import textures
 from .rc import Airframe
-from .room import Prop, Scenario
+from .scenario import Prop, Scenario
 
 DRONE_GROUP = 3
 HIDDEN_GROUP = 4

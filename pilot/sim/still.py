@@ -10,7 +10,7 @@ import numpy as np
 
 from . import mj, rc
 from .camera import CameraModel, Image, Sensor
-from .room import Scenario
+from .scenario import Scenario
 from .scene import build
 
 

@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from .room import MarkerPlate
+from .scenario import MarkerPlate
 
 Image = npt.NDArray[np.uint8]
 

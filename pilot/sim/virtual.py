@@ -20,8 +20,8 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import IO, Any
 
-from ..closing import Closing
-from ..errors import SimulatorError
+from ..common.closing import Closing
+from ..common.errors import SimulatorError
 
 _TYPES: dict[Any, Any] = {"int": int, "float": float, "bool": bool, int: int, float: float, bool: bool}
 REPO = Path(__file__).resolve().parents[2]

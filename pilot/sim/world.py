@@ -17,13 +17,13 @@ from typing import Protocol
 
 import numpy as np
 
-from ..closing import Closing
-from ..errors import FrameSourceError, SimulatorError
-from ..sources import Frame, FrameSourceBase
+from ..common.closing import Closing
+from ..common.errors import FrameSourceError, SimulatorError
+from ..vision.sources import Frame, FrameSourceBase
 from . import mj, rc
 from .camera import CameraModel, Image, Sensor
 from .physics import Airframe, AirframeState
-from .room import Scenario
+from .scenario import Scenario
 from .scene import DRONE_GROUP, HIDDEN_GROUP, build
 from .virtual import Outputs, VirtualDrone
 
@@ -48,7 +48,7 @@ class FlightScore:
 
 
 class PortCounts(Protocol):
-    """What the step barrier needs of the pilot's link (pilot.link.Link)."""
+    """What the step barrier needs of the pilot's link (pilot.link.serial_link.Link)."""
 
     bytes_written: int
     bytes_read: int

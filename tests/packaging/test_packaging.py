@@ -101,7 +101,7 @@ def test_the_project_wheel_installs_one_namespace_of_its_own(tmp_path: Path) -> 
         names = zf.namelist()
     tops = {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")}
     assert tops == {"drone_protocol_tools"}
-    assert "drone_protocol_tools/generator/cli.py" in names and "drone_protocol_tools/pilot/cli.py" in names
+    assert "drone_protocol_tools/generator/cli.py" in names and "drone_protocol_tools/pilot/app/cli.py" in names
     assert any(n.startswith("drone_protocol_tools/generator/templates/python/") for n in names)
     assert re.search(rf"^Requires-Dist: {dp.PROTOCOL_NAME.replace('_', '-')}$", _metadata(wheel), re.M)
 
@@ -109,7 +109,7 @@ def test_the_project_wheel_installs_one_namespace_of_its_own(tmp_path: Path) -> 
 def test_outside_the_repo_the_installed_names_are_the_namespaced_ones(tmp_path: Path) -> None:
     code = (
         "import importlib.util as u\n"
-        "import drone_protocol_tools.generator.cli, drone_protocol_tools.pilot.cli\n"
+        "import drone_protocol_tools.generator.cli, drone_protocol_tools.pilot.app.cli\n"
         "print([n for n in ('generator', 'pilot') if u.find_spec(n) is not None])"
     )
     run = _run(sys.executable, "-c", code, cwd=tmp_path)

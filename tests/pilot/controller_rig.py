@@ -6,10 +6,10 @@ from __future__ import annotations
 import drone_protocol as dp
 from fake_drone import FakeDrone
 
-from pilot.config import ControllerConfig
-from pilot.controller import Controller, State
-from pilot.detect import Detection
-from pilot.detection import range_of
+from pilot.common.config import ControllerConfig
+from pilot.control.controller import Controller, State
+from pilot.vision.detect import Detection
+from pilot.vision.detection import range_of
 
 W, H = 320, 240
 CFG = ControllerConfig()

@@ -8,7 +8,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from pilot.hsv import HsvBlobDetector
+from pilot.vision.hsv.detector import HsvBlobDetector
 
 Image = npt.NDArray[np.uint8]
 FloatImage = npt.NDArray[np.float64]

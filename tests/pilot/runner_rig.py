@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from pilot.sources import Frame
+from pilot.vision.sources import Frame
 
 
 class Clock:

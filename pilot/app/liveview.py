@@ -1,0 +1,306 @@
+"""``--serve HOST:PORT``: a live view of the flight in a browser, with an emergency Stop.
+
+A standard-library HTTP server in daemon threads. Every path starts with a random token printed at
+start-up (``http://127.0.0.1:8080/<token>/``); anything else is 404, so the page and its Stop need the URL.
+
+* ``/<token>/``             the page (``liveview.html``)
+* ``/<token>/stream.mjpg``  the annotated frames, MJPEG (``multipart/x-mixed-replace``); each part carries
+                            ``X-Capture-Ms``, the frame's arrival (Unix ms), so the page can show its latency
+* ``/<token>/state.json``   state, detection and confidence, laser, the last commands and replies, link health
+* ``POST /<token>/stop``    asks the pilot to stop: the loop's next tick raises ``StopRequested`` and the
+                            pilot runs its safe sequence (laser off, land, disarm), as after Ctrl-C
+
+The pilot loop only stores a reference to the newest tick (the sources hand out a new image per frame);
+the stream threads draw the overlay and encode each frame once, off the control loop.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import secrets
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from http import HTTPStatus
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from importlib import resources
+from typing import Any
+
+import cv2
+import drone_protocol as dp
+
+from ..common.errors import PilotError
+from .observers import StopSwitch
+from .overlay import annotate
+from .runner import Tick
+
+BOUNDARY = "liveviewframe"
+HISTORY = 12  # commands shown on the page
+JPEG_QUALITY = 80
+MAX_FPS = 25.0  # per viewer: the camera's rate is 20 Hz; an unpaced (simulated) loop need not be encoded faster
+
+
+def parse_address(text: str) -> tuple[str, int]:
+    """``PORT``, ``:PORT`` or ``HOST:PORT``; the host defaults to 127.0.0.1 (this machine only)."""
+    host, sep, port_text = text.rpartition(":")
+    host = host.strip("[]") if sep else ""
+    try:
+        port = int(port_text)
+    except ValueError:
+        port = -1
+    if not 0 <= port <= 65535:
+        raise PilotError(f"option --serve: expected PORT or HOST:PORT (e.g. 8080 or 0.0.0.0:8080), got {text!r}")
+    return host or "127.0.0.1", port
+
+
+class _Shared:
+    """What the loop thread hands to the server threads, under one lock."""
+
+    def __init__(self) -> None:
+        self.cond = threading.Condition()
+        self.tick: Tick | None = None
+        self.t = 0.0
+        self.capture_ms = 0.0
+        self.seq = 0
+        self.last_command = ""
+        self.jpeg: tuple[int, bytes] | None = None  # (seq, bytes): the newest frame, encoded once
+        self.commands: deque[dict[str, Any]] = deque(maxlen=HISTORY)
+        self.reply_times: deque[float] = deque()
+        self.send_times: deque[float] = deque()
+        self.rejected: deque[float] = deque()
+        self.last_reply_t: float | None = None
+        self.viewers = 0
+        self.ended = ""
+
+
+class LiveView:
+    """An observer of the pilot loop that serves it; ``close()`` stops the server."""
+
+    def __init__(
+        self,
+        host: str,
+        port: int,
+        stop: StopSwitch,
+        *,
+        token: str | None = None,
+        wall_time: Callable[[], float] = time.time,
+    ) -> None:
+        self.stop = stop
+        self.token = token or secrets.token_urlsafe(16)
+        self._wall_time = wall_time
+        self._shared = _Shared()
+        self._t0: float | None = None
+        try:
+            self._server = ThreadingHTTPServer((host, port), self._handler_class())
+        except OSError as exc:
+            raise PilotError(f"option --serve: cannot listen on {host}:{port}: {exc.strerror or exc}") from exc
+        self._server.daemon_threads = True
+        self._thread = threading.Thread(target=self._server.serve_forever, name="liveview", daemon=True)
+        self._thread.start()
+        self._closed = False
+
+    @property
+    def url(self) -> str:
+        address, port = self._server.server_address[:2]
+        host = address.decode() if isinstance(address, bytes) else str(address)
+        shown = f"[{host}]" if ":" in host else host
+        return f"http://{shown}:{port}/{self.token}/"
+
+    @property
+    def viewers(self) -> int:
+        return self._shared.viewers
+
+    # -- the loop's side: cheap, never waits for a browser ------------------------------------------
+    def on_tick(self, tick: Tick) -> None:
+        sh = self._shared
+        if self._t0 is None:
+            self._t0 = tick.t
+        now = tick.t
+        with sh.cond:
+            if tick.command is not None:
+                sh.last_command = tick.command.decode("ascii", "replace")
+                sh.send_times.append(now)
+            for reply in tick.replies:
+                sh.reply_times.append(now)
+                sh.last_reply_t = now
+                if reply.kind.name == "REJECTED":
+                    sh.rejected.append(now)
+            for times, span in ((sh.send_times, 1.0), (sh.reply_times, 1.0), (sh.rejected, 5.0)):
+                while times and times[0] <= now - span:
+                    times.popleft()
+            if tick.command is not None or tick.replies:
+                sh.commands.appendleft({
+                    "t": round(now - self._t0, 2),
+                    "command": sh.last_command if tick.command is not None else "",
+                    "replies": [_reply_text(r) for r in tick.replies],
+                })
+            if tick.frame is not None:
+                sh.tick, sh.t, sh.seq = tick, now - self._t0, sh.seq + 1
+                # the frame's arrival on the wall clock, comparable with the browser's Date.now()
+                sh.capture_ms = self._wall_time() * 1000.0 - (time.perf_counter() - tick.frame_t) * 1000.0
+            sh.cond.notify_all()
+
+    def end(self, summary: str) -> None:
+        """The flight is over: the page shows `summary`; streams end."""
+        with self._shared.cond:
+            self._shared.ended = summary
+            self._shared.cond.notify_all()
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        if not self._shared.ended:
+            self.end("the pilot has stopped")
+        self._server.shutdown()
+        self._server.server_close()
+        self._thread.join(timeout=5)
+
+    def __enter__(self) -> LiveView:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # -- the server's side -------------------------------------------------------------------------------
+    def _frame(self) -> tuple[int, bytes, float] | None:
+        """The newest frame as JPEG (encoded once, by whichever stream thread asks first)."""
+        sh = self._shared
+        with sh.cond:
+            tick, t, seq, last, capture_ms = sh.tick, sh.t, sh.seq, sh.last_command, sh.capture_ms
+            if sh.jpeg is not None and sh.jpeg[0] == seq:
+                return seq, sh.jpeg[1], capture_ms
+        if tick is None:
+            return None
+        ok, buf = cv2.imencode(".jpg", annotate(tick, t, last), [cv2.IMWRITE_JPEG_QUALITY, JPEG_QUALITY])
+        if not ok:
+            return None
+        data = buf.tobytes()
+        with sh.cond:
+            if sh.jpeg is None or sh.jpeg[0] < seq:
+                sh.jpeg = (seq, data)
+        return seq, data, capture_ms
+
+    def state(self) -> dict[str, Any]:
+        sh = self._shared
+        with sh.cond:
+            tick, now = sh.tick, sh.t
+            det = tick.detection if tick is not None else None
+            since_reply = None
+            if sh.last_reply_t is not None and tick is not None:
+                since_reply = round(tick.t - sh.last_reply_t, 2)
+            return {
+                "t": round(now, 2),
+                "frame": sh.seq,
+                "state": tick.state.value if tick is not None else "starting",
+                "laser": bool(tick.laser_on) if tick is not None else False,
+                "detection": None if det is None else {
+                    "found": det.found, "cx": round(det.cx, 1), "cy": round(det.cy, 1),
+                    "size": round(det.size, 1), "confidence": round(det.confidence, 3),
+                },
+                "commands": list(sh.commands),
+                "link": {
+                    "sent_per_s": len(sh.send_times),
+                    "replies_per_s": len(sh.reply_times),
+                    "rejected_last_5s": len(sh.rejected),
+                    "last_reply_s_ago": since_reply,
+                },
+                "stop_requested": self.stop.requested,
+                "ended": sh.ended,
+            }
+
+    def _stream(self, write: Callable[[bytes], None]) -> None:
+        sh = self._shared
+        sent = [0]  # the last frame sent to this viewer
+        last_write = -1.0
+        with sh.cond:
+            sh.viewers += 1
+        try:
+            while True:
+                with sh.cond:
+                    sh.cond.wait_for(lambda: sh.seq > sent[0] or bool(sh.ended), timeout=1.0)
+                    if sh.ended:
+                        return
+                    if sh.seq <= sent[0]:
+                        continue
+                due = last_write + 1.0 / MAX_FPS - time.monotonic()
+                if due > 0:  # then send the newest frame there is by then
+                    time.sleep(due)
+                frame = self._frame()
+                if frame is None:
+                    continue
+                seq, data, capture_ms = frame
+                sent[0] = seq
+                last_write = time.monotonic()
+                head = (f"--{BOUNDARY}\r\nContent-Type: image/jpeg\r\nContent-Length: {len(data)}\r\n"
+                        f"X-Capture-Ms: {capture_ms:.1f}\r\nX-Frame: {seq}\r\n\r\n")
+                write(head.encode("ascii") + data + b"\r\n")
+        finally:
+            with sh.cond:
+                sh.viewers -= 1
+
+    def _handler_class(self) -> type[BaseHTTPRequestHandler]:
+        view = self
+
+        class Handler(BaseHTTPRequestHandler):
+            server_version = "pilot-liveview"
+
+            def log_message(self, format: str, *args: Any) -> None:
+                pass  # the pilot's terminal shows its status line, not an access log
+
+            def _route(self) -> str | None:
+                prefix = f"/{view.token}/"
+                path = self.path.split("?", 1)[0]
+                if path == prefix.rstrip("/"):
+                    return ""
+                return path[len(prefix):] if path.startswith(prefix) else None
+
+            def _send(self, status: int, body: bytes, kind: str) -> None:
+                self.send_response(status)
+                self.send_header("Content-Type", kind)
+                self.send_header("Content-Length", str(len(body)))
+                self.send_header("Cache-Control", "no-store")
+                self.end_headers()
+                self.wfile.write(body)
+
+            def do_GET(self) -> None:
+                route = self._route()
+                if route == "":
+                    page = resources.files(__package__).joinpath("liveview.html").read_bytes()
+                    self._send(HTTPStatus.OK, page, "text/html; charset=utf-8")
+                elif route == "state.json":
+                    self._send(HTTPStatus.OK, json.dumps(view.state()).encode(), "application/json")
+                elif route == "stream.mjpg":
+                    self.send_response(HTTPStatus.OK)
+                    self.send_header("Content-Type", f"multipart/x-mixed-replace; boundary={BOUNDARY}")
+                    self.send_header("Cache-Control", "no-store")
+                    self.end_headers()
+                    with contextlib.suppress(BrokenPipeError, ConnectionResetError):  # the viewer left
+                        view._stream(self._write)
+                else:
+                    self._send(HTTPStatus.NOT_FOUND, b"not found\n", "text/plain")
+
+            def _write(self, data: bytes) -> None:
+                self.wfile.write(data)
+                self.wfile.flush()
+
+            def do_POST(self) -> None:
+                if self._route() != "stop":
+                    self._send(HTTPStatus.NOT_FOUND, b"not found\n", "text/plain")
+                    return
+                view.stop.request(f"Stop from the live view ({self.client_address[0]})")
+                self._send(HTTPStatus.OK, json.dumps({"stop_requested": True}).encode(), "application/json")
+
+        return Handler
+
+
+def _reply_text(reply: dp.Reply) -> str:
+    text = f"{reply.kind.name.lower()}"
+    detail = "".join(x for x in (reply.category, reply.direction) if x)
+    if detail:
+        text += f" {detail}"
+    if reply.error:
+        text += f" ({reply.error})"
+    return text

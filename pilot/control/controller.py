@@ -1,0 +1,399 @@
+"""The pilot's decision logic: one explicit state machine over detections, with an injected clock.
+
+``Controller.update(detection)`` is called once per frame and returns the frame to send now (or
+``None``: nothing new, the link keeps the firmware alive). Every frame is built by a
+``drone_protocol`` function; every time and pulse limit comes from its constants.
+
+States (``State``)::
+
+    IDLE -> ARM -> TAKEOFF -> HOLD -> SEARCH <-> ACQUIRE -> TRACK <-> AIM -> FIRE -> LAND -> DONE
+                                        ^                    |        |      |
+                                        +---- target lost ---+--------+------+   (neutral first)
+
+* The drone's state and laser come from its replies (``DroneView``), never from what was sent. Whenever
+  the confirmed laser differs from what the pilot wants, the deterministic ``laser_on()``/``laser_off()``
+  goes out before anything else, so a lost frame costs one reply round trip.
+* ARM sends ``arm()`` (again whenever the drone reports it disarmed) until the drone confirms an armed
+  state, then waits ``arm_margin_ms``; it gives up if no arming is confirmed in time.
+* TAKEOFF climbs (``move_up``) for ``takeoff_ms``; HOLD sends ``hold_altitude()`` for ``settle_ms``.
+* SEARCH turns (a bounded sweep: ``search_max_ms`` in all, unconfirmed sightings included, then LAND)
+  towards the side the target was last seen, in legs of ``search_leg_ms`` (about a turn) flown at the start
+  height, one ``search_step_ms`` climb below it, one above it...: something in front may hide the target
+  from one height. A search after a sighting first goes back to the height it was seen from (``SeenFrom``).
+* ACQUIRE stops turning and needs ``acquire_frames`` consecutive sightings to go on to TRACK; after
+  ``lost_frames`` misses in a row it searches again.
+* TRACK corrects one axis per frame: yaw while the horizontal error is outside its dead band, then
+  height while the vertical error is, else forward until the apparent size reaches ``approach_size``.
+  The camera leans with the airframe (``Lean``, estimated from the pitch commands): a brake is never so hard
+  that its lean drops the target out of the frame. A target lost after a climb (or descent) is hidden from
+  above (below): a ceiling (floor) just inside the height it was seen from bars the height correction while the
+  target stays near the frame's middle, and the approach goes on off-centre (``pilot.control.vertical``).
+  AIM begins there and returns to TRACK only below ``retreat_size`` (hysteresis); above ``back_off_size`` it
+  backs off before it fires. Back in TRACK with the camera panned, the body turns to the target before the
+  servos reset (a reset would otherwise swing it out of the frame). A target that stands still in the frame through
+  ``response.NO_RESPONSE_MS`` of hard turning means a drone that does not answer its sticks (crashed, caught): LAND.
+  Up to ``coast_frames`` missed frames during a forward approach keep it going (a
+  far target flickers in and out of detection).
+* AIM holds position and centres the target with the pan/tilt servos (only from measured sightings: a
+  tracker's prediction knows nothing of the step just sent); after ``aim_frames`` centred
+  frames FIRE switches the laser on (not while the detector sees something else at the aim point: a thing in
+  front of the target hides its middle while the circle through its rim stays centred). The laser stays on only
+  while the target is found, centred, in range and clear at the aim point;
+  after ``fire_ms`` lit (as the drone confirmed it) it is switched off and the drone lands. While
+  firing, small errors (within twice the aim tolerance) are still corrected
+  with the servos; larger ones switch the laser off and go back to AIM.
+* Losing the target (``lost_frames`` misses in a row) in ACQUIRE/TRACK/AIM/FIRE: laser off, sticks
+  neutral (``hold_altitude()``), servos reset, and SEARCH again.
+* LAND (also what ``abort()`` leads to): laser off until confirmed, servos home, then the firmware's
+  landing routine (``land()``; ``disarm()`` when the drone is armed on the ground) until the drone
+  confirms a landing, then keep-alives until it confirms not armed with the laser off (DONE). After
+  ``land_ms`` without that confirmation it stops (DONE) and the firmware's failsafe takes over.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+
+import drone_protocol as dp
+
+from ..common.config import ControllerConfig
+from ..vision.detection import Detection
+from ..vision.gating import Gate
+from .approach import ClosingSpeed, Lean, Momentum, allowed_speed
+from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, speed_for, turn_towards
+from .response import TurnResponse, turn_sense
+from .sticks import HeldSticks
+from .vertical import Height, SeenFrom
+
+__all__ = ["FLYING", "LOCKED", "Controller", "State", "Transition"]
+
+HOLD_MPS = 0.12  # closing speeds within this are left alone near the target (the estimate's noise)
+VIEW_EDGE = 0.9  # a brake's lean keeps the target's lower edge above this share of the frame's lower half
+MIN_BRAKE = 0.4  # speed steps: the gentlest brake, whatever the view allows
+RETURN_TOL_M = 0.05  # a search's return to the height the target was seen from ends this close to it
+RETURN_MAX_MS = 3000  # ... or this long after the search began
+
+
+def _brake_steps(speed: float) -> float:
+    """The pitch-back stick, in speed steps, against a closing speed: harder the faster it closes, up to 1.4."""
+    return min(1.4, 0.8 + speed)
+
+
+class Controller(ControllerCore):
+    def __init__(self, config: ControllerConfig | None = None, clock: Callable[[], float] = time.monotonic) -> None:
+        super().__init__(config, clock)
+        self.gate = Gate(self.cfg)  # vision gate (issue 12): every sighting and every laser-on goes through it
+        self.closing = ClosingSpeed()
+        # the same over 1.2 s, for the speed at a loss: a target going out of sight (covered, clipped by the
+        # frame's edge) shrinks in its last frames, and the short fit then reads a closing speed near zero
+        self.closing_trend = ClosingSpeed(window_s=1.2, min_samples=8)
+        self.momentum = Momentum(self.cfg.pitch_accel_mps2)
+        # the same from the commands alone, never reset by vision: a target being covered keeps its size while the
+        # drone flies on, and vision's speed then drops to zero just before the loss
+        self.reckoned = Momentum(self.cfg.pitch_accel_mps2)
+        self.lean = Lean(self.cfg.pitch_accel_mps2)
+        self.height = Height(self.cfg.climb_mps_per_step)
+        self.seen_from = SeenFrom()
+        self._return_m: float | None = None  # a search first goes back to this height
+        self.sticks = HeldSticks()
+        self.response = TurnResponse()
+        self._turned = 0  # the last frame's hard turn (+1 right, -1 left), whose effect this frame shows
+        self._last_ms = self._now()
+        self._brake_until_ms = 0  # target lost while closing in: brake this long before searching
+        self._brake_speed = 0.0
+
+    def _hold_range(self, det: Detection) -> bytes | None:
+        """Near the target nothing holds position but the pilot: brake a closing speed, nudge forward against a
+        receding one; None while the range holds (within ``HOLD_MPS``)."""
+        closing = self.closing.closing
+        if closing is None or abs(closing) <= HOLD_MPS:
+            return None
+        if closing > 0.0:
+            return self._brake(closing, det)
+        return self._emit(dp.move_forward(speed_for(dp.CommandName.MOVE_FORWARD, min(1.2, 0.6 - closing))))
+
+    def _brake(self, speed: float, det: Detection | None = None) -> bytes:
+        """Pitch back against a closing speed (``_brake_steps``), with the target in view no harder than keeps it in
+        the frame (the nose comes up with the brake, see ``_brake_room``)."""
+        frac = _brake_steps(speed)
+        if det is not None and det.found:
+            frac = max(MIN_BRAKE, min(frac, self._brake_room(det)))
+        return self._emit(dp.move_backward(speed_for(dp.CommandName.MOVE_BACKWARD, frac)))
+
+    def _brake_room(self, det: Detection) -> float:
+        """The backward lean, in speed steps, that keeps the target's lower edge within ``VIEW_EDGE`` of the
+        frame: the target moves down the frame by the change from the present lean."""
+        tan_v = self._tan_v(det)
+        edge = det.error_y + (det.size / det.height if det.height else 0.0)
+        room_deg = math.degrees(math.atan(VIEW_EDGE * tan_v) - math.atan(edge * tan_v))
+        return (room_deg - self.lean.deg) / self.lean.deg_per_step
+
+    def _decide(self, det: Detection | None) -> bytes | None:
+        now = self._now()
+        held = self.sticks.pitch(now)
+        dt = (now - self._last_ms) / 1000.0
+        self.momentum.advance(held, dt)
+        self.reckoned.advance(held, dt)
+        self.lean.advance(held, dt)
+        self.height.advance(self.sticks.throttle(now), dt)
+        self._last_ms = now
+        if det is not None and det.found and self.state in LOCKED:
+            self.closing.update(now / 1000.0, det.range_m)
+            self.closing_trend.update(now / 1000.0, det.range_m)
+            self.momentum.observe(self.closing.closing)
+        elif self.state not in LOCKED and self.state is not State.SEARCH:
+            self.closing.reset()
+            self.closing_trend.reset()
+            self.momentum.reset()
+            self.reckoned.reset()
+        cx = det.cx if det is not None and det.found and not det.predicted else None
+        if self.state is not State.TRACK:
+            self.response.reset()
+        elif self.response.observe(now, self._turned, cx, det.width if det is not None else 0):
+            self._go(State.LAND, "the drone does not answer the yaw stick (the target stood still through a hard "
+                                 "turn): crashed or caught on something")
+        frame = self._decide_frame(det)
+        if det is not None and self.gate.acquired() and not det.predicted:
+            self.seen_from.saw(self.height.m)
+        self.sticks.sent(frame, self._now())
+        self._turned = turn_sense(frame)
+        return frame
+
+    def _decide_frame(self, det: Detection | None) -> bytes | None:
+        # -- vision gate (issue 12): a bad frame holds (laser off), too many in a row land ------------
+        self.gate.observe(det)
+        if self.gate.fault is not None and self.state in FLYING - {State.TAKEOFF, State.HOLD}:
+            if self.gate.fault_frames >= self.cfg.blind_frames:
+                off = self._laser(False)
+                self._go(State.LAND, f"camera: {self.gate.fault.value} frames")
+                return off if off is not None else self._on_land(det)
+            off = self._laser(False)
+            return off if off is not None else self._emit(dp.hold_altitude())
+        # -- end of the vision gate --------------------------------------------------------------------
+        return super()._decide(det)
+
+    def _found(self, det: Detection | None) -> bool:
+        return det is not None and det.found and self.gate.acquired()  # vision gate: confident enough
+
+    def _on_search(self, det: Detection | None) -> bytes | None:
+        if self._found(det):
+            self._go(State.ACQUIRE, "target seen")
+            return self._on_acquire(det)
+        if self._now() < self._brake_until_ms:
+            return self._brake(self._brake_speed)
+        if self._now() - self._search_started_ms >= self.cfg.search_max_ms:
+            self._go(State.LAND, "search sweep exhausted")
+            return self._on_land(det)
+        if self._pan_offset or self._tilt_offset:
+            self._pan_offset = self._tilt_offset = 0
+            return self._emit(dp.servo_reset())
+        back = self._return_step()
+        if back is not None:
+            return self._emit(back)
+        step = self._search_step(self._now() - self._search_started_ms)
+        if step is not None:
+            return self._emit(step)
+        if self._search_sign > 0:
+            return self._emit(dp.turn_right(speed_for(dp.CommandName.TURN_RIGHT, 1.0)))
+        return self._emit(dp.turn_left(speed_for(dp.CommandName.TURN_LEFT, 1.0)))
+
+    def _go(self, new: State, reason: str) -> None:
+        if new is State.SEARCH and self.state is not State.SEARCH:
+            self.seen_from.lost(self.height.m)
+            self._return_m = self.seen_from.return_to()
+        super()._go(new, reason)
+
+    def _return_step(self) -> bytes | None:
+        """Before sweeping, back to the height the target was last seen from (a climb may have hidden it)."""
+        if self._return_m is None:
+            return None
+        off = self._return_m - self.height.settles_m
+        if abs(off) <= RETURN_TOL_M or self._elapsed() > RETURN_MAX_MS:
+            self._return_m = None
+            return None
+        if off > 0.0:
+            return dp.move_up(speed_for(dp.CommandName.MOVE_UP, 1.0))
+        return dp.move_down(speed_for(dp.CommandName.MOVE_DOWN, 1.0))
+
+    def _search_step(self, elapsed_ms: int) -> bytes | None:
+        """The height change due this far into the sweep (None: turn): after each leg one step down, then two
+        up, two down..., so the legs sweep at the start height, one step below it, one above it..."""
+        leg, step = self.cfg.search_leg_ms, self.cfg.search_step_ms
+        t, k = elapsed_ms, 0
+        while t >= leg:
+            t -= leg
+            moving = step if k == 0 else 2 * step
+            if t < moving:
+                if k % 2 == 0:
+                    return dp.move_down(speed_for(dp.CommandName.MOVE_DOWN, 1.0))
+                return dp.move_up(speed_for(dp.CommandName.MOVE_UP, 1.0))
+            t -= moving
+            k += 1
+        return None
+
+    def _lost(self, det: Detection | None, limit: int) -> bool:
+        if self._found(det):
+            self._misses = 0
+            return False
+        self._misses += 1
+        return self._misses >= limit
+
+    def _to_search(self, reason: str) -> bytes | None:
+        """Target lost: laser off first, then sticks neutral, then the servos home, then search; lost while
+        closing in, the search starts by braking for as long as the last closing speed needs."""
+        off = self._laser(False)
+        # vision's last estimate carried on by dead reckoning, the commands' own reckoning, or the longer trend:
+        # whichever is fastest
+        closing = max(self.momentum.speed, self.reckoned.speed, self.closing_trend.closing or 0.0)
+        if closing > 0.15:
+            # as long as that brake takes to stop it (plus the lean's lag), not longer: a brake held on flies the
+            # drone backwards into whatever is behind it, where the camera does not look
+            decel = self.cfg.pitch_accel_mps2 * _brake_steps(closing)
+            self._brake_until_ms = self._now() + round(1000.0 * (closing / decel + self.lean.lag_s))
+            self._brake_speed = closing
+        self._go(State.SEARCH, reason)
+        return off if off is not None else self._emit(dp.hold_altitude())
+
+    def _on_acquire(self, det: Detection | None) -> bytes | None:
+        if self._found(det):
+            assert det is not None
+            self._hits += 1
+            self._misses = 0
+            self._remember_side(det)
+            if self._hits >= self.cfg.acquire_frames:
+                self._go(State.TRACK, f"seen in {self._hits} consecutive frames")
+                return self._on_track(det)
+            return self._hold(det)
+        self._hits = 0  # the sightings must be consecutive
+        self._misses += 1
+        if self._misses >= self.cfg.lost_frames:  # hovering, a flickering far target gets a few chances
+            self._go(State.SEARCH, "sighting not confirmed")
+        return self._hold(det)
+
+    def _hold(self, det: Detection | None) -> bytes | None:
+        """Sticks neutral while a sighting is confirmed, unless the brake planned at a loss is not over: a target
+        seen again at once (half covered, flickering) would otherwise let the drone coast on into what covers it."""
+        if self._now() < self._brake_until_ms:
+            return self._brake(self._brake_speed, det)
+        return self._emit(dp.hold_altitude())
+
+    def _on_track(self, det: Detection | None) -> bytes | None:
+        if self._lost(det, self.cfg.lost_frames):
+            return self._to_search("target lost while tracking")
+        if det is None or not self._found(det):
+            if self._coast is not None and self._misses <= self.cfg.coast_frames:
+                return self._emit(self._coast)  # a missed frame or two (a far, flickering target): keep approaching
+            return self._emit(dp.hold_altitude())
+        self._coast = None
+        cfg = self.cfg
+        if self._pan_offset or self._tilt_offset:
+            turn = self._turn_to_camera(det)  # the body first, where a reset would lose the target
+            if turn is not None:
+                return self._emit(turn)
+            self._pan_offset = self._tilt_offset = 0
+            return self._emit(dp.servo_reset())
+        ex, ey, size = det.error_x, det.error_y, det.relative_size
+        self._remember_side(det)
+        if size >= cfg.approach_size:  # close enough whatever else is off: AIM centres it with the servos
+            self._go(State.AIM, f"close enough (size {size:.3f})")
+            return self._on_aim(det)
+        closing, allowed = self.closing.closing, cfg.approach_speed_mps
+        if closing is None:  # too few consistent ranges yet: the speed its own pitch commands gave it
+            closing = self.momentum.speed
+        if det.range_m > 0.0:
+            # the range still to go before the aim range (range scales as 1/size), and the speed allowed there
+            allowed = allowed_speed(det.range_m * (1.0 - size / cfg.approach_size), cfg.brake_mps2,
+                                    cfg.approach_speed_mps)
+            if closing > allowed + 0.15:  # braking comes before any other correction
+                return self._brake(closing - allowed, det)
+        if abs(ex) > cfg.dead_band_x:
+            return self._emit(turn_towards(ex))
+        if abs(ey) > cfg.dead_band_y and not self.seen_from.barred(ey < 0, self.height.settles_m, ey):
+            frac = 0.5 + 0.5 * min(1.0, abs(ey) / 0.6)
+            if ey < 0:
+                return self._emit(dp.move_up(speed_for(dp.CommandName.MOVE_UP, frac)))
+            return self._emit(dp.move_down(speed_for(dp.CommandName.MOVE_DOWN, frac)))
+        if closing > allowed - 0.1:
+            return self._emit(dp.hold_altitude())  # coasting at about the right speed
+        frac = 1.8 if size < 0.45 * cfg.approach_size else (1.0 if size < 0.75 * cfg.approach_size else 0.6)
+        self._coast = self._emit(dp.move_forward(speed_for(dp.CommandName.MOVE_FORWARD, frac)))
+        return self._coast
+
+    def _on_aim(self, det: Detection | None) -> bytes | None:
+        if self._lost(det, self.cfg.lost_frames):
+            return self._to_search("target lost while aiming")
+        if det is None or not self._found(det):
+            return self._emit(dp.hold_altitude())
+        self._remember_side(det)
+        if det.relative_size < self.cfg.retreat_size:
+            self._go(State.TRACK, f"target receded (size {det.relative_size:.3f})")
+            return self._on_track(det)
+        if det.relative_size > self.cfg.back_off_size:
+            # coasted in too close (a lock lost on the way): a landing from here comes down on the target's
+            # stand, so back off first (once backing away, the range hold below brakes it)
+            self._centred = 0
+            closing = self.closing.closing
+            if closing is None or closing > -HOLD_MPS:
+                return self._brake(max(0.0, closing or 0.0), det)
+        hold = self._hold_range(det)
+        if hold is not None:  # still coasting in (or drifting away): that first
+            self._centred = 0
+            return hold
+        if det.predicted:
+            # bridged, not seen: the prediction knows nothing of the servo step just sent (whose swing may be what
+            # blurred the target away), so another step from it would repeat that one
+            return self._emit(dp.hold_altitude())
+        correction = self._servo_correction(det)
+        if correction is not None:
+            self._centred = 0
+            return correction
+        self._centred += 1
+        # vision gate: confirmed to fire, and nothing in front of the target's middle where the ray goes
+        if self._centred >= self.cfg.aim_frames and self.gate.confirmed() and det.aim_on_target is not False:
+            self._go(State.FIRE, "locked and centred")
+            self._fire_started_ms = self._now()
+            self.lit_ms = 0
+            return self._laser(True)
+        return self._emit(dp.hold_altitude())
+
+    def _on_fire(self, det: Detection | None) -> bytes | None:
+        lit_now = self.lit_ms
+        if lit_now < self.cfg.fire_ms and self._now() - self._fire_started_ms >= 4 * self.cfg.fire_ms:
+            off = self._laser(False)
+            self._go(State.LAND, f"laser confirmed on for only {lit_now} ms")
+            return off if off is not None else self._on_land(det)
+        if lit_now >= self.cfg.fire_ms:
+            self.fired = True
+            off = self._laser(False)
+            self._go(State.LAND, f"laser on target for {lit_now} ms")
+            return off if off is not None else self._on_land(det)
+        if det is None or not self._found(det):
+            self._misses += 1
+            off = self._laser(False)  # never lit without a lock
+            if self._misses >= self.cfg.lost_frames:
+                self._go(State.SEARCH, "target lost while firing")
+            return off if off is not None else self._emit(dp.hold_altitude())
+        self._misses = 0
+        self._remember_side(det)
+        loose = 2.0 * self.cfg.aim_tolerance
+        far = det.relative_size < self.cfg.retreat_size  # drifted back out of range (AIM approaches again)
+        blocked = det.aim_on_target is False  # something in front of the target, where the ray goes
+        if far or blocked or abs(det.error_x) > loose or abs(det.error_y) > loose:
+            off = self._laser(False)
+            why = "out of range" if far else ("something in front of the target" if blocked else "off centre")
+            self._go(State.AIM, f"{why} while firing")
+            return off if off is not None else self._on_aim(det)
+        if not self.gate.confirmed():  # vision gate: found, but not confirmed in enough frames in a row
+            off = self._laser(False)
+            return off if off is not None else self._emit(dp.hold_altitude())
+        on = self._laser(True)
+        if on is not None:
+            return on
+        # still within the loose tolerance: keep centring it (a drifting drone), the laser stays on
+        correction = self._servo_correction(det)
+        if correction is not None:
+            return correction
+        hold = self._hold_range(det)
+        return hold if hold is not None else self._emit(dp.hold_altitude())

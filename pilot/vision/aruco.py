@@ -1,0 +1,117 @@
+"""The ArUco marker detector, with parameters for the frames a drone sees: blur, the frame's edge, dim light.
+
+Each was chosen on the tuning photos of bench/vision (RESULTS.md has the figures), for recall under motion
+blur and at the frame's edge, zero false positives, and a cost near OpenCV's defaults:
+
+* ``minDistanceToBorder`` 0: a marker touching the frame's edge is still read (OpenCV's default, 3 px,
+  drops it just when the drone turns towards it).
+* Two adaptive-threshold windows, 3 and 23 px (OpenCV's default adds 13): the third pass found no marker
+  the other two missed and cost a third of the time.
+* A minimum perimeter in pixels (a side of ``MIN_SIDE_PX``): smaller quads cannot carry a readable 6x6
+  cell grid, and the many tiny contours of a textured room are most of the default's cost.
+* ``polygonalApproxAccuracyRate`` 0.05 (default 0.03): a blurred or clipped marker's outline is rounder.
+* ``perspectiveRemovePixelPerCell`` 8 (default 4): each cell is read from 8x8 pixels of the unwarped marker, not
+  4x4; a cell blurred into its neighbours is read more surely (motion blur on the tuning photos' dev seeds: 85.5,
+  82.0, 76.0 -> 88.0, 88.0, 81.0 % of 200 markers; the frame's edge 83.5 -> 85.5 %; the same time per frame, no
+  false positive in 2,400 views; the ignored margin of each cell, 0.13 to 0.4, made no difference with it).
+* Sub-pixel corner refinement: the centre and the side (hence the range) to a fraction of a pixel.
+* A second look at half resolution when the full frame has no marker: motion blur halves with the image
+  and the look costs a quarter of the first.
+Every marker of the configured id is a candidate; its size must imply a plausible range.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+from cv2.typing import MatLike
+
+from ..common.config import ArucoConfig, VisionConfig
+from ..common.errors import ConfigError
+from .detection import Candidate, Detection, best_detection, frame_size, malformed, range_of
+
+
+def aruco_dictionary(name: str) -> cv2.aruco.Dictionary:
+    code = getattr(cv2.aruco, name, None)
+    if not name.startswith("DICT_") or not isinstance(code, int):
+        raise ConfigError(f"aruco.dictionary: unknown ArUco dictionary {name!r} (e.g. DICT_4X4_50)")
+    return cv2.aruco.getPredefinedDictionary(code)
+
+
+MIN_SIDE_PX = 8  # the smallest marker side searched, pixels of the searched image
+
+
+def detector_parameters(adaptive_thresh_constant: float, searched_width: int = 320) -> cv2.aruco.DetectorParameters:
+    params = cv2.aruco.DetectorParameters()
+    params.adaptiveThreshConstant = adaptive_thresh_constant
+    params.adaptiveThreshWinSizeMin = 3
+    params.adaptiveThreshWinSizeMax = 23
+    params.adaptiveThreshWinSizeStep = 20
+    params.minMarkerPerimeterRate = min(1.0, 4.0 * MIN_SIDE_PX / max(1, searched_width))
+    params.polygonalApproxAccuracyRate = 0.05
+    params.perspectiveRemovePixelPerCell = 8
+    params.minDistanceToBorder = 0
+    params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
+    params.cornerRefinementWinSize = 3
+    return params
+
+
+class ArucoMarkerDetector:
+    name = "aruco"
+
+    def __init__(
+        self, config: ArucoConfig | None = None, vision: VisionConfig | None = None, fov_deg: float = 60.0
+    ) -> None:
+        cfg = config or ArucoConfig()
+        self.cfg = cfg
+        self.marker_id = cfg.marker_id
+        self.vision = vision or VisionConfig()
+        self.fov_deg = fov_deg
+        self._dictionary = aruco_dictionary(cfg.dictionary)
+        self._detectors: dict[int, cv2.aruco.ArucoDetector] = {}  # per searched width (the minimum perimeter)
+
+    def _detector(self, searched_width: int) -> cv2.aruco.ArucoDetector:
+        det = self._detectors.get(searched_width)
+        if det is None:
+            params = detector_parameters(self.cfg.adaptive_thresh_constant, searched_width)
+            det = self._detectors[searched_width] = cv2.aruco.ArucoDetector(self._dictionary, params)
+        return det
+
+    def _markers(self, grey: MatLike, scale: float, width: int) -> list[Candidate]:
+        corners, ids, _ = self._detector(max(grey.shape[:2])).detectMarkers(grey)
+        if ids is None or len(corners) == 0:
+            return []
+        found = []
+        for quad, marker in zip(corners, np.asarray(ids).reshape(-1), strict=True):
+            if self.marker_id >= 0 and int(marker) != self.marker_id:
+                continue
+            pts = np.asarray(quad, dtype=np.float64).reshape(4, 2) * scale
+            side = float(np.linalg.norm(pts - np.roll(pts, 1, axis=0), axis=1).mean())
+            distance = range_of(side, self.cfg.marker_size_m, width, self.fov_deg)
+            if self.vision.range_min_m <= distance <= self.vision.range_max_m:
+                centre = pts.mean(axis=0)
+                found.append(Candidate(float(centre[0]), float(centre[1]), side, 1.0))
+        return sorted(found, key=lambda c: c.size, reverse=True)
+
+    def candidates(self, image: MatLike) -> list[Candidate]:
+        """Every candidate, best first; an empty list for a frame ``detection.malformed`` names (no OpenCV error)."""
+        if malformed(image) is not None:
+            return []
+        grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+        width = frame_size(image)[0]
+        found = self._markers(grey, 1.0, width)
+        if not found:
+            found = self._markers(cv2.pyrDown(grey), 2.0, width)  # pyrDown's pixel j is centred on pixel 2j
+        return found
+
+    def detect(self, image: MatLike) -> Detection:
+        """This frame alone, the best candidate (no tracking, no frame checks)."""
+        return best_detection(self, image, self.cfg.marker_size_m, self.fov_deg)
+
+    def aim_on_target(self, image: MatLike, size: float) -> bool | None:
+        """Not measured: a marker is black and white like much else, and a marker partly covered is not read."""
+        return None
+
+    def candidates_near(self, image: MatLike, cx: float, cy: float, size: float) -> list[Candidate]:
+        """None: a marker's cells are read whole or not at all, and the frame's look read them already."""
+        return []

@@ -1,0 +1,130 @@
+"""Closed-loop flights in the MuJoCo simulator: the pilot flies against the real virtual drone over a
+pseudo-terminal, stepped clock, through the emulated ArduCopter; a representative dozen (the campaign of
+hundreds is bench/flight, `make bench-flight`).
+
+Every flight must end landed, disarmed, laser off; none may light anything but the target, touch a wall or
+crash; and at least 11 of the 12 must reach and light the target (the campaign measures the rate itself)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from pilot.app.sim_flight import SUCCESS_LIT_MS, FlightJob, FlightResult, fly, fly_many
+from pilot.common.config import VisionConfig
+from pilot.sim.room import make_scenario
+
+HSV_DOZEN = ("ahead", "behind", "side", "high", "low", "hidden", "distractor", "cluttered", "red_distractors", "dim")
+ARUCO_PAIR = ("ahead", "marker_edge")
+SEED = 3
+REQUIRED = 11
+
+
+@pytest.fixture(scope="module")
+def flights(virtual_drone: Path) -> list[FlightResult]:
+    jobs = [FlightJob(name, SEED, "hsv", executable=str(virtual_drone)) for name in HSV_DOZEN]
+    jobs += [FlightJob(name, SEED, "aruco", width=640, height=480, executable=str(virtual_drone))
+             for name in ARUCO_PAIR]
+    results = fly_many(jobs, processes=2)
+    for job, result in zip(jobs, results, strict=True):
+        assert (result.scenario, result.seed, result.detector) == (job.scenario, job.seed, job.detector)
+    return results
+
+
+def test_the_dozen_reach_and_light_the_target(flights: list[FlightResult]) -> None:
+    ok = [r for r in flights if r.success]
+    failures = "\n".join(r.summary() for r in flights if not r.success)
+    assert len(ok) >= REQUIRED, f"{len(ok)}/{len(flights)} succeeded:\n{failures}"
+    for r in ok:
+        assert r.lit_on_target_ms >= SUCCESS_LIT_MS and r.reached and r.fired
+        assert r.min_distance <= 2.0
+
+
+def test_no_flight_lights_anything_else_touches_a_wall_or_crashes(flights: list[FlightResult]) -> None:
+    for r in flights:
+        assert r.non_target_hits == 0, (r.summary(), r.non_target_what)
+        assert r.wall_hits == 0, r.summary()
+        assert r.crashes == 0, r.summary()
+        assert not r.final_laser and not r.final_armed and not r.final_fc_armed, r.summary()
+        assert r.final_altitude < 0.02, r.summary()
+        assert r.error is None, r.summary()
+        assert r.final_state == "done", r.summary()
+
+
+def test_a_flight_is_deterministic_for_its_seed(virtual_drone: Path) -> None:
+    a = fly("distractor", 7, executable=virtual_drone, max_seconds=12.0)
+    b = fly("distractor", 7, executable=virtual_drone, max_seconds=12.0)
+    c = fly("distractor", 8, executable=virtual_drone, max_seconds=12.0)
+    key = ("frames_sent", "sim_seconds", "min_distance", "lit_on_target_ms", "reason")
+    assert [getattr(a, k) for k in key] == [getattr(b, k) for k in key]
+    assert [getattr(a, k) for k in key] != [getattr(c, k) for k in key]
+
+
+def test_recording(virtual_drone: Path, tmp_path: Path) -> None:
+    import json
+
+    import cv2
+
+    r = fly("side", 3, record_dir=tmp_path, executable=virtual_drone)
+    assert r.success
+    assert r.video and Path(r.video).stat().st_size > 10_000
+    cap = cv2.VideoCapture(r.video)
+    frames = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
+    cap.release()
+    assert frames > 100
+    lines = [json.loads(line) for line in (tmp_path / "log.jsonl").read_text().splitlines()]
+    states = {d["state"] for d in lines if "state" in d}
+    assert {"arm", "search", "track", "fire", "land"} <= states
+    assert any(d.get("link") == "tx" for d in lines) and any(d.get("link") == "rx" for d in lines)
+    assert "result" in lines[-1]
+    picture = cv2.imread(str(r.path_picture))
+    assert picture is not None and picture.shape[0] > 300
+
+
+def test_the_scenarios_really_differ() -> None:
+    """Behind and side need a search turn; hidden covers the target; red_distractors has red things."""
+    hidden = make_scenario("hidden", 0)
+    assert hidden.hidden and not hidden.target_visible(hidden.hidden[0].start)
+    for name in ("behind", "side"):
+        sc = make_scenario(name, 0)
+        x, y, heading = sc.start
+        tx, ty, _ = sc.target.position
+        bearing = (math.degrees(math.atan2(ty - y, tx - x) - heading) + 180) % 360 - 180
+        assert abs(bearing) > 60, (name, bearing)  # outside the 60-degree field of view at the start
+    assert len(make_scenario("red_distractors", 0).distractors) >= 3
+    assert make_scenario("moving_target", 0).target_offset(4.0) != (0.0, 0.0)
+    assert make_scenario("ahead", 1, gusts=0.5).gusts == 0.5 and make_scenario("ahead", 1).wind == (0.0, 0.0)
+
+
+# the camera fails as the laser comes on, for less than controller.blind_frames (20 frames, 1 s): the pilot holds
+# with the laser off through it, then fires again
+SHORT_FAULTS = ("black@fire+0.6", "frozen@fire+0.6", "small@fire+0.6", "grey@fire+0.6")
+DARK = "saturated@9+60"
+
+
+@pytest.fixture(scope="module")
+def faulty(virtual_drone: Path) -> dict[str, FlightResult]:
+    faults = (*SHORT_FAULTS, DARK)
+    results = fly_many([FlightJob("ahead", SEED, executable=str(virtual_drone), fault=f) for f in faults], processes=2)
+    return dict(zip(faults, results, strict=True))
+
+
+@pytest.mark.parametrize("fault", SHORT_FAULTS)
+def test_a_short_camera_fault_holds_with_the_laser_off_then_the_flight_goes_on(faulty: dict[str, FlightResult],
+                                                                                fault: str) -> None:
+    r = faulty[fault]
+    # off within one reply round trip of the first bad frame; a frozen camera is known only after
+    # vision.frozen_frames identical frames (its repeats look like good frames until then)
+    late = (VisionConfig().frozen_frames - 1) * 50 if fault.startswith("frozen") else 0
+    assert 0 < r.lit_during_fault_ms <= 100 + late, r.summary()
+    assert r.non_target_hits == 0 and r.wall_hits == 0 and r.crashes == 0, r.summary()
+    assert r.success, r.summary()
+
+
+def test_a_camera_that_stays_dark_lands_the_drone(faulty: dict[str, FlightResult]) -> None:
+    r = faulty[DARK]
+    assert r.landed_because == "camera: saturated frames", r.summary()
+    assert not r.success and r.lit_on_target_ms == 0 and r.lit_during_fault_ms == 0
+    assert not r.final_laser and not r.final_fc_armed and r.final_altitude < 0.02 and r.crashes == 0, r.summary()
