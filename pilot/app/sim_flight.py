@@ -90,6 +90,7 @@ class FlightJob:
     max_wind: float = 0.0
     gusts: float = 0.0
     fault: str | None = None  # a camera fault, KIND@START+DURATION (world.CameraFault)
+    ideal: bool = False  # the randomised world's effects off (pilot/sim/randomise.py)
 
 
 def sim_link(
@@ -130,11 +131,12 @@ def fly(
     max_wind: float = 0.0,
     gusts: float = 0.0,
     fault: str | None = None,
+    ideal: bool = False,
 ) -> FlightResult:
     cfg = config or PilotConfig()
     if detector_name is not None:
         cfg = dataclasses.replace(cfg, detector=detector_name)
-    scenario = make_scenario(scenario_name, seed, noise=noise, max_wind=max_wind, gusts=gusts)
+    scenario = make_scenario(scenario_name, seed, noise=noise, max_wind=max_wind, gusts=gusts, ideal=ideal)
     detector = make_detector(cfg)
     recorder = Recorder(record_dir, fps=cfg.link.rate_hz) if record_dir is not None else None
     wall0 = time.perf_counter()
@@ -245,6 +247,7 @@ def _fly_job(job: FlightJob) -> FlightResult:
         max_wind=job.max_wind,
         gusts=job.gusts,
         fault=job.fault,
+        ideal=job.ideal,
     )
 
 

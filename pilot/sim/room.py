@@ -15,7 +15,7 @@ import zlib
 import numpy as np
 
 from ..common.errors import ConfigError
-from . import furnish
+from . import furnish, placement, randomise
 from .scenario import Ball, Interval, Light, MarkerPlate, Room, Scenario
 
 BASIC = ("ahead", "behind", "side", "high", "low", "hidden", "distractor")
@@ -54,13 +54,17 @@ def _lights(name: str, rng: np.random.Generator, noise: bool) -> tuple[tuple[Lig
 
 
 def make_scenario(
-    name: str, seed: int, *, noise: bool = True, marker: bool = True, max_wind: float = 0.0, gusts: float = 0.0
+    name: str, seed: int, *, noise: bool = True, marker: bool = True, max_wind: float = 0.0, gusts: float = 0.0,
+    ideal: bool = False,
 ) -> Scenario:
     """A named scenario; ``seed`` varies the start pose, the target's bearing, distance and height, the
     furniture, with ``noise`` the lighting, the sensor noise and the compression, and with ``max_wind`` (m/s) a
-    steady wind up to it and ``gusts`` (m/s) random gusts (both off by default: still air)."""
+    steady wind up to it and ``gusts`` (m/s) random gusts (both off by default: still air). ``ideal`` turns the
+    randomised world's effects off (``randomise.py``), the sensor noise too."""
     if name not in SCENARIOS:
         raise ConfigError(f"unknown scenario {name!r}; known: {', '.join(SCENARIOS)}")
+    effects = randomise.draw(name, seed, ideal=ideal)
+    noise = noise and not ideal
     rng = _rng(name, seed)
     room = Room()
     for _ in range(1000):
@@ -102,7 +106,7 @@ def make_scenario(
     wind_speed = float(rng.uniform(0.0, 1.0)) * max_wind
     wind_dir = float(rng.uniform(-math.pi, math.pi))
     dim = name == "dim"
-    return Scenario(
+    built = Scenario(
         name=name,
         seed=seed,
         room=room,
@@ -122,4 +126,7 @@ def make_scenario(
         jpeg_quality=int(rng.integers(70, 95)) if noise else 95,
         wind=(wind_speed * math.cos(wind_dir), wind_speed * math.sin(wind_dir)),
         gusts=gusts,
+        effects=effects,
     )
+    placement.check(built)
+    return built

@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from .randomise import IDEAL, Effects
+
 Vec3 = tuple[float, float, float]
 RGB = tuple[float, float, float]
 BGR = tuple[int, int, int]
@@ -111,6 +113,7 @@ class Scenario:
     wind: tuple[float, float] = (0.0, 0.0)  # steady wind, m/s along x and y
     gusts: float = 0.0  # gust strength, m/s (a seeded random process)
     time_budget_s: float = 60.0
+    effects: Effects = IDEAL  # the randomised world's imperfections (randomise.py)
     wall_margin: float = field(default=0.25)  # the drone's radius
 
     def target_visible(self, t: float) -> bool:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from . import textures
+from . import placement, textures
 from .rc import Airframe
 from .scenario import Prop, Scenario
 
@@ -86,6 +86,7 @@ class _Writer:
 
 def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg: float) -> Built:
     sc, room = scenario, scenario.room
+    placement.check(sc)  # a spawn or target in a wall or a piece of furniture is refused, never flown
     w = _Writer()
     walls = w.photo_material(sc.wall_texture, (4.0, 1.5), "0.85 0.82 0.78 1")
     floor = w.photo_material(sc.floor_texture, (6.0, 5.0), "0.7 0.68 0.62 1")

@@ -74,7 +74,7 @@ class SimWorld(Closing):
         self.scenario = scenario
         self.vd = vd
         self.camera_model = camera or CameraModel()
-        self.params = params or rc.load()
+        self.params = (params or rc.load()).varied(scenario.effects)
         built = build(scenario, self.params.airframe, self.camera_model.width, self.camera_model.height,
                       self.camera_model.fovy_deg)
         try:
