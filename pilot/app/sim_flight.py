@@ -60,6 +60,7 @@ class FlightResult:
     error: str | None = None
     physics_ms: float = 0.0  # wall time in physics and the flight controller
     render_ms: float = 0.0  # wall time in MuJoCo's renderer
+    sensor_ms: float = 0.0  # wall time in the camera sensor's effects
     frames: int = 0
     non_target_what: tuple[str, ...] = ()
     lit_during_fault_ms: int = 0  # laser on while the camera was faulty (a fault injected with ``fault``)
@@ -224,6 +225,7 @@ def fly(
                 video=str(recorder.video_path) if recorder is not None else None,
                 physics_ms=score.physics_ms,
                 render_ms=score.render_ms,
+                sensor_ms=score.sensor_ms,
                 frames=score.frames,
                 non_target_what=tuple(score.non_target_what),
                 lit_during_fault_ms=score.lit_during_fault_ms,

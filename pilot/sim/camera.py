@@ -75,6 +75,7 @@ class Sensor:
         self._last_axis: FloatArray | None = None
         self._last_t = 0.0
         self.render_ms = 0.0  # time in MuJoCo's renderer for the last frame (the simulator's figures)
+        self.sensor_ms = 0.0  # time in the sensor's effects for the last frame
 
     def _noise_frames(self, rng: np.random.Generator) -> dict[float, list[tuple[Image, Image]]]:
         """Sensor noise drawn once per seed (drawing it per frame costs more than MuJoCo's render): for gains of
@@ -108,9 +109,11 @@ class Sensor:
         t0 = time.perf_counter()
         self.renderer.update_scene(self.data, camera=self.cam_id)
         rgb = self.renderer.render()
-        self.render_ms = (time.perf_counter() - t0) * 1000.0
-        img: Image = np.ascontiguousarray(rgb[..., ::-1])
-        return self._sensor(img, t)
+        t1 = time.perf_counter()
+        self.render_ms = (t1 - t0) * 1000.0
+        img: Image = self._sensor(np.ascontiguousarray(rgb[..., ::-1]), t)
+        self.sensor_ms = (time.perf_counter() - t1) * 1000.0
+        return img
 
     def _sensor(self, img: Image, t: float) -> Image:
         sc, cam = self.sc, self.cam
