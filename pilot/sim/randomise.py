@@ -37,6 +37,7 @@ RANGES: dict[str, tuple[float, float, str]] = {
     "awb_tau_s": (0.0, 10.0, "s"),
     "readout_s": (0.0, 0.1, "s"),
     "shadows": (0.0, 1.0, "(0 off, 1 on)"),
+    "picam": (0.0, 1.0, "(0: a USB webcam, 1: the Pi camera)"),
 }
 # what a seed draws (uniformly) for each field
 DRAWN: dict[str, tuple[float, float]] = {
@@ -57,6 +58,7 @@ DRAWN: dict[str, tuple[float, float]] = {
     "awb_tau_s": (0.5, 1.5),
     "readout_s": (0.015, 0.03),
     "shadows": (1.0, 1.0),
+    "picam": (0.0, 1.0),  # rounded: half the seeds fly the Pi camera
 }
 
 
@@ -69,7 +71,8 @@ class Effects:
     ``baro_drift_m`` over a minute and a ground effect (``ground_effect_m`` too low on the floor, fading over
     ``GROUND_EFFECT_HEIGHT_M``); attitude noise. Latency: exposure to pilot, dropped frames (each one makes the
     pilot's frame one camera period older), the servos' slew. Camera: auto-exposure and auto-white-balance
-    time constants, rolling-shutter readout, shadows."""
+    time constants, shadows, and the profile: the Pi camera (``picam`` 1: uncompressed frames, a rolling shutter
+    read over ``readout_s``) or a USB webcam (0: MJPEG at the scenario's quality, global shutter)."""
 
     mass_scale: float = 1.0
     thrust_scale: float = 1.0
@@ -88,6 +91,7 @@ class Effects:
     awb_tau_s: float = 0.0
     readout_s: float = 0.0
     shadows: float = 0.0
+    picam: float = 0.0
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
@@ -115,6 +119,8 @@ def draw(name: str, seed: int, *, ideal: bool = False, overrides: Mapping[str, f
     if not ideal:
         rng = np.random.default_rng([zlib.crc32(name.encode()), seed, 0xEFFEC7])
         values = {name: float(rng.uniform(lo, hi)) for name, (lo, hi) in DRAWN.items()}
+        values["picam"] = float(round(values["picam"]))
+        values["readout_s"] *= values["picam"]
     for name, value in (overrides or {}).items():
         if name not in RANGES:
             raise ConfigError(f"simulator parameter {name!r}: unknown; known: {', '.join(RANGES)}")

@@ -18,6 +18,7 @@ HIDDEN_GROUP = 4
 CAMERA_POS = (0.23, 0.0, -0.03)  # on the airframe's nose, below the arms
 ZNEAR = 0.001  # the camera's near clipping plane, in the room's extents (about 1 cm): at MuJoCo's 0.01 (11 cm), a
 # wall within 9 cm of the airframe's nose vanished, and the camera saw the black outside the room
+SHADOW_MAP_PX = 1024  # the shadow map's side: MuJoCo's 4096 costs the software renderer more for no visible gain
 MOTOR_SPIN = (1, -1, 1, -1)  # front-left, front-right... alternating directions cancel the reaction torque
 
 
@@ -129,8 +130,9 @@ def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg
         bx, by = 0.022 * math.cos(f), 0.022 * math.sin(f)
         target_geoms.append(f'<geom name="target_backing" type="box" pos="{_f(bx, by, plate.centre[2])}" '
                             f'quat="{_yaw_quat(f)}" size="{_f(0.008, half, half)}" material="{pole}"/>')
+    shadows = "true" if sc.effects.shadows else "false"
     lights = [f'<light name="light_{i}" pos="{_f(*lt.position)}" dir="{_f(*lt.direction)}" '
-              f'diffuse="{_f(*lt.rgb)}" specular="0.1 0.1 0.1" castshadow="false" attenuation="1 0 0"/>'
+              f'diffuse="{_f(*lt.rgb)}" specular="0.1 0.1 0.1" castshadow="{shadows}" attenuation="1 0 0"/>'
               for i, lt in enumerate(sc.lights)]
     motors = motor_positions(frame.arm_m)
     sites = "\n".join(f'      <site name="motor_{i}" pos="{_f(x, y, 0.02)}" size="0.01" group="{DRONE_GROUP}"/>'
@@ -142,15 +144,15 @@ def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg
     sx, sy, heading = sc.start
     ix, iy, iz = frame.inertia
     amb = sc.ambient
-    # no shadows and no multisampling: MSAA doubled the software renderer's cost (5 -> 10 ms at 320x240), and
-    # the sensor's JPEG and motion blur soften the edges anyway
+    # no multisampling: MSAA doubled the software renderer's cost (5 -> 10 ms at 320x240), and the sensor's JPEG
+    # and motion blur soften the edges anyway; shadows (the randomised world's) from a SHADOW_MAP_PX map
     xml = f"""<mujoco model="room">
   <compiler angle="radian"/>
   <option timestep="0.002"/>
   <visual>
     <global offwidth="{width}" offheight="{height}"/>
     <headlight ambient="{_f(amb, amb, amb)}" diffuse="0 0 0" specular="0 0 0"/>
-    <quality shadowsize="0" offsamples="0"/>
+    <quality shadowsize="{SHADOW_MAP_PX if sc.effects.shadows else 0}" offsamples="0"/>
     <map znear="{ZNEAR}"/>
   </visual>
   <asset>
