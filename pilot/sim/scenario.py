@@ -104,8 +104,10 @@ class Scenario:
     target_motion: Vec3 = (0.0, 0.0, 1.0)  # amplitude (m) along x, along y, period (s): a moving target
     lights: tuple[Light, ...] = ()
     ambient: float = 0.3
-    wall_texture: str = "brick"
+    wall_texture: str = "brick"  # a photograph of textures.SURFACES, drawn at its real scale
     floor_texture: str = "gravel"
+    wall_rgb: RGB = (0.85, 0.82, 0.78)  # the photograph's tint: painted or bare brick, concrete's shade
+    floor_rgb: RGB = (0.7, 0.68, 0.62)
     window: bool = False  # a bright window on the wall behind the target (backlit)
     exposure_s: float = 1.0 / 120.0  # the camera's exposure time: motion blur
     noise_sigma: float = 0.0  # sensor noise at unit gain

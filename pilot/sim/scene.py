@@ -69,6 +69,18 @@ class _Writer:
                               f'rgba="{rgba}"/>')
         return name
 
+    def surface_material(self, surface: str, rgb: tuple[float, float, float]) -> str:
+        """A wall or floor photograph repeated at its real scale (MuJoCo's texuniform: repeats per metre)."""
+        name = f"surface_{surface}_{len(self.materials)}"
+        file = f"surface_{surface}.png"
+        if file not in self.assets:
+            self.assets[file] = textures.surface(surface)
+            self.materials.append(f'<texture name="tex_surface_{surface}" type="2d" file="{file}"/>')
+        per_m = 1.0 / textures.SURFACES[surface].metres
+        self.materials.append(f'<material name="{name}" texture="tex_surface_{surface}" texuniform="true" '
+                              f'texrepeat="{_f(per_m, per_m)}" rgba="{_f(*rgb, 1.0)}" specular="0.1"/>')
+        return name
+
     def colour_material(self, name: str, rgb: tuple[float, float, float], emission: float = 0.0) -> str:
         self.materials.append(f'<material name="{name}" rgba="{_f(*rgb, 1.0)}" emission="{emission:g}" '
                               f'specular="0.2" shininess="0.3"/>')
@@ -89,8 +101,8 @@ def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg
     sc, room = scenario, scenario.room
     placement.check(sc)  # a spawn or target in a wall or a piece of furniture is refused, never flown
     w = _Writer()
-    walls = w.photo_material(sc.wall_texture, (4.0, 1.5), "0.85 0.82 0.78 1")
-    floor = w.photo_material(sc.floor_texture, (6.0, 5.0), "0.7 0.68 0.62 1")
+    walls = w.surface_material(sc.wall_texture, sc.wall_rgb)
+    floor = w.surface_material(sc.floor_texture, sc.floor_rgb)
     ceiling = w.colour_material("ceiling", (0.88, 0.88, 0.86))
     target = w.colour_material("target", sc.target.rgb)
     pole = w.colour_material("pole", (0.42, 0.42, 0.42))
@@ -195,4 +207,13 @@ def _window(w: _Writer, sc: Scenario) -> str:
     on_x_wall = abs(t - ts[0]) < 1e-9  # the line meets a wall of constant x first
     heading = (math.pi if dx > 0 else 0.0) if on_x_wall else (-math.pi / 2 if dy > 0 else math.pi / 2)
     mat = w.colour_material("window", (1.0, 0.98, 0.92), emission=2.5)
-    return _wall_plane("window", x, y, 1.6, heading, (1.0, 0.8), mat, offset=0.02, solid=False)
+    frame = w.colour_material("window_frame", (0.85, 0.85, 0.82))
+    # the pane, then its frame and a cross of glazing bars in front of it (the bars cut the backlight as a
+    # real window's do)
+    along = (-math.sin(heading), math.cos(heading))
+    parts = [_wall_plane("window", x, y, 1.6, heading, (1.0, 0.8), mat, offset=0.02, solid=False)]
+    for i, (u, z, half) in enumerate(((0.0, 1.6, (0.03, 0.8)), (0.0, 1.6, (1.0, 0.03)), (-1.0, 1.6, (0.05, 0.85)),
+                                      (1.0, 1.6, (0.05, 0.85)), (0.0, 0.8, (1.05, 0.05)), (0.0, 2.4, (1.05, 0.05)))):
+        parts.append(_wall_plane(f"window_bar_{i}", x + u * along[0], y + u * along[1], z, heading, half, frame,
+                                 offset=0.025, solid=False))
+    return "\n    ".join(parts)

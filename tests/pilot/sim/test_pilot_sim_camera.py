@@ -5,6 +5,7 @@ USB webcam's MJPEG)."""
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import cv2
 import numpy as np
@@ -13,6 +14,7 @@ import pytest
 from pilot.sim.camera import CameraModel, Image
 from pilot.sim.randomise import Effects
 from pilot.sim.room import make_scenario
+from pilot.sim.scenario import Prop
 from pilot.sim.still import StillView
 
 
@@ -35,13 +37,16 @@ def _raw(view: StillView) -> Image:
 def test_the_lights_cast_shadows_in_the_randomised_world() -> None:
     shots = []
     for effects in (Effects(), Effects(shadows=1.0)):
-        view = _view(effects, "cluttered")
-        x, y, heading = view.scenario.start
-        view.place(x, y, 1.5, heading, tilt=60.0)  # looking down at the floor and the furniture's feet
+        sc = make_scenario("ahead", 2, ideal=True)
+        x, y, heading = sc.start
+        ahead = (x + 2.0 * math.cos(heading), y + 2.0 * math.sin(heading), 0.4)
+        cube = Prop("box", ahead, (0.4, 0.4, 0.4), (0.6, 0.6, 0.6))  # a cabinet 2 m ahead, on the floor
+        view = StillView(dataclasses.replace(sc, props=(cube,), effects=effects), CameraModel(160, 120))
+        view.place(x, y, 1.5, heading, tilt=60.0)  # looking down at it and the floor around it
         shots.append(_raw(view).astype(np.int16))
         view.close()
     darker = shots[0] - shots[1]
-    assert darker.max() > 20  # some of the floor lies in a shadow ...
+    assert darker.max() > 20  # some of the floor lies in its shadow ...
     assert darker.min() >= -2  # ... and nothing got lighter
 
 
