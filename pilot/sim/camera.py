@@ -111,13 +111,13 @@ class Sensor:
         return np.array(self.data.cam_xpos[self.cam_id]), -xmat[:, 2]
 
     def render(self, t: float) -> Image:
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         self.renderer.update_scene(self.data, camera=self.cam_id)
         rgb = self.renderer.render()
-        t1 = time.perf_counter()
+        t1 = time.process_time()
         self.render_ms = (t1 - t0) * 1000.0
         img: Image = self._sensor(np.ascontiguousarray(rgb[..., ::-1]), t)
-        self.sensor_ms = (time.perf_counter() - t1) * 1000.0
+        self.sensor_ms = (time.process_time() - t1) * 1000.0
         return img
 
     def _sensor(self, img: Image, t: float) -> Image:
