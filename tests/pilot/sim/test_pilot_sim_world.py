@@ -119,3 +119,24 @@ def test_the_barometer_reads_low_in_the_ground_effect_with_the_motors_on() -> No
     assert rig.af.estimator.height_error == 0.0  # above the wash's reach
     rig.af.estimator.height(0.0, True, 0.002)
     assert rig.af.estimator.height_error == pytest.approx(-0.3)
+
+
+class _Flown(Exception):
+    pass
+
+
+@pytest.mark.parametrize(("argv", "ideal"), [(["--ideal"], True), ([], False)])
+def test_the_ideal_flag_turns_the_world_s_effects_off_for_the_flight(monkeypatch: pytest.MonkeyPatch,
+                                                                    argv: list[str], ideal: bool) -> None:
+    from pilot.app import cli, sim_flight
+
+    seen: dict[str, object] = {}
+
+    def fake_fly(*args: object, **kwargs: object) -> None:
+        seen.update(kwargs)
+        raise _Flown
+
+    monkeypatch.setattr(sim_flight, "fly", fake_fly)
+    with pytest.raises(_Flown):
+        cli.main([*argv, "--no-status"])
+    assert seen["ideal"] is ideal
