@@ -72,6 +72,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scenario", choices=SCENARIOS, default="ahead", help="simulated scenario (default ahead)")
     p.add_argument("--max-seconds", type=float, default=60.0, help="flight time limit, seconds (default 60)")
     p.add_argument("--wind", type=float, default=0.0, help="simulated steady wind, up to this many m/s (default 0)")
+    p.add_argument("--ideal", action="store_true",
+                   help="simulated world without its randomised effects (airframe, estimation, latency, camera)")
     p.add_argument("--gusts", type=float, default=0.0, help="simulated gusts of about this many m/s (default 0)")
     p.add_argument("--camera-fault", metavar="KIND@START+SECONDS",
                    help="simulated camera fault: black, saturated, frozen, small or grey, from START seconds "
@@ -232,6 +234,7 @@ def _fly_sim_with(args: argparse.Namespace, cfg: PilotConfig, observers: list[Ob
         max_wind=args.wind,
         gusts=args.gusts,
         fault=args.camera_fault,
+        ideal=args.ideal,
     )
 
 

@@ -60,6 +60,7 @@ class FlightResult:
     error: str | None = None
     physics_ms: float = 0.0  # wall time in physics and the flight controller
     render_ms: float = 0.0  # wall time in MuJoCo's renderer
+    sensor_ms: float = 0.0  # wall time in the camera sensor's effects
     frames: int = 0
     non_target_what: tuple[str, ...] = ()
     lit_during_fault_ms: int = 0  # laser on while the camera was faulty (a fault injected with ``fault``)
@@ -90,6 +91,7 @@ class FlightJob:
     max_wind: float = 0.0
     gusts: float = 0.0
     fault: str | None = None  # a camera fault, KIND@START+DURATION (world.CameraFault)
+    ideal: bool = False  # the randomised world's effects off (pilot/sim/randomise.py)
 
 
 def sim_link(
@@ -130,11 +132,12 @@ def fly(
     max_wind: float = 0.0,
     gusts: float = 0.0,
     fault: str | None = None,
+    ideal: bool = False,
 ) -> FlightResult:
     cfg = config or PilotConfig()
     if detector_name is not None:
         cfg = dataclasses.replace(cfg, detector=detector_name)
-    scenario = make_scenario(scenario_name, seed, noise=noise, max_wind=max_wind, gusts=gusts)
+    scenario = make_scenario(scenario_name, seed, noise=noise, max_wind=max_wind, gusts=gusts, ideal=ideal)
     detector = make_detector(cfg)
     recorder = Recorder(record_dir, fps=cfg.link.rate_hz) if record_dir is not None else None
     wall0 = time.perf_counter()
@@ -222,6 +225,7 @@ def fly(
                 video=str(recorder.video_path) if recorder is not None else None,
                 physics_ms=score.physics_ms,
                 render_ms=score.render_ms,
+                sensor_ms=score.sensor_ms,
                 frames=score.frames,
                 non_target_what=tuple(score.non_target_what),
                 lit_during_fault_ms=score.lit_during_fault_ms,
@@ -245,6 +249,7 @@ def _fly_job(job: FlightJob) -> FlightResult:
         max_wind=job.max_wind,
         gusts=job.gusts,
         fault=job.fault,
+        ideal=job.ideal,
     )
 
 

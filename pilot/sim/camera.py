@@ -4,8 +4,9 @@ The mount sits on the airframe's nose and moves with it (lean, turn); the firmwa
 turn it (at the spec's default angles it looks straight ahead along the airframe). The laser shares the
 camera's optical axis. Each frame: MuJoCo's offscreen render, then the sensor: auto-exposure, motion blur from
 the camera's actual angular rate over the exposure time, optionally a rolling shutter's skew (rows read one after
-another over ``readout_s``, each shifted by the image motion since the middle row), Gaussian noise growing with the
-gain (drawn once per seed and cycled), JPEG compression.
+another over ``readout_s``, each shifted by the image motion since the middle row), auto-exposure and auto white
+balance (grey world) that settle with their time constants after a change of scene, Gaussian noise growing with
+the gain (drawn once per seed and cycled), JPEG compression (a USB webcam's MJPEG; the Pi camera has none).
 """
 
 from __future__ import annotations
@@ -70,11 +71,16 @@ class Sensor:
         self.cam_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, "eye")
         self.renderer = mujoco.Renderer(model, camera.height, camera.width)
         self.gain = 1.0
+        self.white = (1.0, 1.0, 1.0)  # auto white balance's gains, B, G, R
+        self.effects = scenario.effects
+        self.readout_s = max(camera.readout_s, scenario.effects.readout_s)
+        self._last_frame_t: float | None = None
         self._noise = self._noise_frames(np.random.default_rng([scenario.seed, 0x5EED]))
         self._frame_count = 0
         self._last_axis: FloatArray | None = None
         self._last_t = 0.0
         self.render_ms = 0.0  # time in MuJoCo's renderer for the last frame (the simulator's figures)
+        self.sensor_ms = 0.0  # time in the sensor's effects for the last frame
 
     def _noise_frames(self, rng: np.random.Generator) -> dict[float, list[tuple[Image, Image]]]:
         """Sensor noise drawn once per seed (drawing it per frame costs more than MuJoCo's render): for gains of
@@ -105,36 +111,60 @@ class Sensor:
         return np.array(self.data.cam_xpos[self.cam_id]), -xmat[:, 2]
 
     def render(self, t: float) -> Image:
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         self.renderer.update_scene(self.data, camera=self.cam_id)
         rgb = self.renderer.render()
-        self.render_ms = (time.perf_counter() - t0) * 1000.0
-        img: Image = np.ascontiguousarray(rgb[..., ::-1])
-        return self._sensor(img, t)
+        t1 = time.process_time()
+        self.render_ms = (t1 - t0) * 1000.0
+        img: Image = self._sensor(np.ascontiguousarray(rgb[..., ::-1]), t)
+        self.sensor_ms = (time.process_time() - t1) * 1000.0
+        return img
 
     def _sensor(self, img: Image, t: float) -> Image:
-        sc, cam = self.sc, self.cam
-        mean = sum(cv2.mean(img)[:3]) / 3.0
-        wanted = cam.target_brightness / max(mean, 1.0) * self.gain
-        self.gain += (min(cam.max_gain, max(0.5, wanted)) - self.gain) * 0.5  # auto-exposure settles in a few frames
+        sc = self.sc
+        self._auto(cv2.mean(img)[:3], t)
         out = img
         flow = self._image_motion(t)
         blur = None if flow is None else _blur_kernel(flow * self.sc.exposure_s)
         if blur is not None:
             out = np.asarray(cv2.filter2D(out, -1, blur), dtype=np.uint8)
-        if flow is not None and cam.readout_s > 0.0:
-            out = rolling_shutter(out, flow, cam.readout_s)
-        if abs(self.gain - 1.0) > 1e-3:
-            out = np.asarray(cv2.convertScaleAbs(out, alpha=self.gain, beta=0.0), dtype=np.uint8)
+        if flow is not None and self.readout_s > 0.0:
+            out = rolling_shutter(out, flow, self.readout_s)
+        gains = tuple(self.gain * w for w in self.white)
+        if max(abs(g - 1.0) for g in gains) > 1e-3:
+            out = np.asarray(cv2.transform(out, np.diag(np.asarray(gains))), dtype=np.uint8)
         if self._noise:
             nearest = min(NOISE_GAINS, key=lambda g: abs(math.log(g / self.gain)))
             pos, neg = self._noise[nearest][self._frame_count % NOISE_FRAMES]
             out = np.asarray(cv2.subtract(cv2.add(out, pos), neg), dtype=np.uint8)
         self._frame_count += 1
+        if self.effects.picam:
+            return out
         ok, data = cv2.imencode(".jpg", out, [cv2.IMWRITE_JPEG_QUALITY, sc.jpeg_quality])
         if ok:
             out = np.asarray(cv2.imdecode(data, cv2.IMREAD_COLOR), dtype=np.uint8)
         return out
+
+    def _auto(self, means: tuple[float, ...], t: float) -> None:
+        """Auto-exposure towards ``target_brightness`` and grey-world white balance from the rendered frame's
+        channel means, each a first-order lag of its time constant (settled at the first frame: the camera ran
+        before take-off). Without a time constant (the ideal world) the exposure moves half-way each frame by the
+        earlier rule, which overshoots to its limits, and there is no white balance."""
+        cam, e = self.cam, self.effects
+        grey = max(sum(means) / 3.0, 1.0)
+        first, dt = self._last_frame_t is None, max(t - (self._last_frame_t or 0.0), 0.0)
+        self._last_frame_t = t
+        if e.ae_tau_s <= 0.0:
+            wanted = cam.target_brightness / grey * self.gain
+            self.gain += (min(cam.max_gain, max(0.5, wanted)) - self.gain) * 0.5
+            return
+        a = 1.0 if first else 1.0 - math.exp(-dt / e.ae_tau_s)
+        self.gain += (min(cam.max_gain, max(0.5, cam.target_brightness / grey)) - self.gain) * a
+        if e.awb_tau_s > 0.0:
+            a = 1.0 if first else 1.0 - math.exp(-dt / e.awb_tau_s)
+            want = [min(2.0, max(0.5, grey / max(c, 1.0))) for c in means]
+            b, g, r = (w + (v - w) * a for w, v in zip(self.white, want, strict=True))
+            self.white = (b, g, r)
 
     def _image_motion(self, t: float) -> FloatArray | None:
         """The image's motion (px/s, x right, y down) from the optical axis' angular rate since the last frame."""

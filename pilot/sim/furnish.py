@@ -10,8 +10,8 @@ import numpy as np
 
 from . import scenario as r
 
-WALL_TEXTURES = ("brick", "text", "page")
-FLOOR_TEXTURES = ("gravel", "grass", "coins")
+WALL_TEXTURES = ("brick",)  # textures.SURFACES: photographs drawn at their real scale
+FLOOR_TEXTURES = ("gravel",)
 POSTERS = ("astronaut", "coffee", "chelsea", "rocket", "hubble_deep_field", "immunohistochemistry", "camera")
 FURNITURE_RGB: tuple[r.RGB, ...] = ((0.45, 0.32, 0.2), (0.55, 0.55, 0.52), (0.2, 0.25, 0.35), (0.7, 0.68, 0.6))
 # not the target, but near its hue: orange, pink, red-brown, and pure reds
@@ -122,7 +122,7 @@ def red_things(p: Placement) -> tuple[r.Prop, ...]:
 
 
 def occluder(p: Placement, target: r.Vec3, radius: float) -> tuple[r.Prop, ...]:
-    """A thin panel between the start and the target that covers about 30 % of the ball from the start."""
+    """A thin panel standing between the start and the target that covers about 30 % of the ball from the start."""
     (sx, sy), (tx, ty, tz) = p.start, target
     heading = math.atan2(ty - sy, tx - sx)
     back = 0.6  # in front of the target, along the line of sight
@@ -135,4 +135,5 @@ def occluder(p: Placement, target: r.Vec3, radius: float) -> tuple[r.Prop, ...]:
     half_w = 0.3
     offset = edge + side * half_w
     px, py = cx - offset * math.sin(heading), cy + offset * math.cos(heading)
-    return (r.Prop("box", (px, py, tz), (0.02, half_w, 0.4), (0.5, 0.5, 0.5), heading),)
+    top = tz + 0.4  # a room divider standing on the floor, its top 0.4 m above the ball's centre
+    return (r.Prop("box", (px, py, top / 2.0), (0.02, half_w, top / 2.0), (0.5, 0.5, 0.5), heading),)

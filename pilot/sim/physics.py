@@ -18,6 +18,7 @@ import numpy.typing as npt
 
 from . import mj
 from .arducopter import FlightController, Sensors
+from .estimator import Estimator
 from .mixer import Mixer
 from .rc import SimParams
 from .scenario import Scenario
@@ -58,6 +59,8 @@ class Airframe:
         frame = params.airframe
         self.frame = frame
         self.fc = FlightController(params, frame.mass_kg, 4.0 * frame.motor_max_n)
+        self.estimator = Estimator(scenario.effects, scenario.seed, frame.mass_kg, frame.drag_linear,
+                                   frame.drag_quadratic)
         self.state = AirframeState(x=scenario.start[0], y=scenario.start[1], heading=scenario.start[2])
         self._kp_roll, self._kp_pitch = params["ATC_ANG_RLL_P"], params["ATC_ANG_PIT_P"]
         # the rate loops' integrators (ArduCopter's ATC_RAT_*_I over _P, per second, capped at ATC_RAT_*_IMAX of
@@ -89,16 +92,21 @@ class Airframe:
         mujoco.mj_forward(model, data)
 
     # -- sensing ------------------------------------------------------------------------------------------
-    def sensors(self) -> Sensors:
+    def sensors(self, dt: float = 0.0) -> Sensors:
+        """What the flight controller senses (``dt``: the step the height estimate advances by; 0: the truth)."""
         roll, pitch, yaw = _euler(*self.data.qpos[3:7].tolist())
         v = self.data.qvel.tolist()  # angular part: body frame (FLU) for a free joint
-        # ArduCopter's senses: roll right-down (FLU +x), pitch nose-up (FLU -y), yaw clockwise (FLU -z)
-        return Sensors(roll, -pitch, -yaw, v[3], -v[4], -v[5], float(self.data.qpos[2]) - BODY_HALF_HEIGHT, v[2])
+        height = float(self.data.qpos[2]) - BODY_HALF_HEIGHT
+        if dt > 0.0:  # ArduCopter's senses: roll right-down (FLU +x), pitch nose-up (FLU -y), yaw clockwise (FLU -z)
+            roll, pitch_up = self.estimator.attitude(roll, -pitch)
+            return Sensors(roll, pitch_up, -yaw, v[3], -v[4], -v[5],
+                           self.estimator.height(height, self.fc.armed, dt), v[2])
+        return Sensors(roll, -pitch, -yaw, v[3], -v[4], -v[5], height, v[2])
 
     # -- one step -----------------------------------------------------------------------------------------
     def step(self, pulses: tuple[float, float, float, float, float], dt: float) -> None:
         mujoco = mj.module()
-        s = self.sensors()
+        s = self.sensors(dt)
         demand = self.fc.step(pulses, s, dt)
         frame = self.frame
         ctrl = self.data.ctrl

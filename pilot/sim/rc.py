@@ -10,6 +10,8 @@ with a dead zone; the throttle is 0..1000 above its minimum plus a dead zone; a 
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +21,7 @@ import drone_protocol as dp
 import yaml
 
 from ..common.errors import ConfigError
+from .randomise import Effects
 
 HERE = Path(__file__).resolve().parent
 PARAMS_YAML = HERE / "arducopter.yaml"
@@ -27,6 +30,18 @@ STICKS = (dp.ChannelName.ROLL, dp.ChannelName.PITCH, dp.ChannelName.THROTTLE, dp
 MODE_SLOT_BOUNDS_US = (1230, 1360, 1490, 1620, 1749)  # ArduPilot's read_6pos_switch
 ANGLE_RANGE = 4500.0
 THROTTLE_RANGE = 1000.0
+# physical ranges, checked at load: the airframe's figures, and ArduCopter's documented ranges of its parameters
+AIRFRAME_RANGES: dict[str, tuple[float, float]] = {
+    "mass_kg": (0.05, 50.0), "arm_m": (0.02, 2.0), "motor_max_n": (0.1, 500.0), "motor_tau_s": (0.001, 1.0),
+    "yaw_moment_m": (0.0, 0.5), "drag_linear": (0.0, 50.0), "drag_quadratic": (0.0, 50.0),
+    "rate_gain": (0.1, 200.0), "crash_speed": (0.1, 20.0), "radius_m": (0.02, 2.0),
+}
+PARAM_RANGES: dict[str, tuple[float, float]] = {
+    "ANGLE_MAX": (1000.0, 8000.0), "ATC_INPUT_TC": (0.0, 1.0), "PILOT_Y_RATE": (1.0, 500.0),
+    "THR_DZ": (0.0, 300.0), "PILOT_SPEED_UP": (10.0, 1000.0), "PILOT_SPEED_DN": (0.0, 1000.0),
+    "PILOT_ACCEL_Z": (50.0, 500.0), "MOT_THST_HOVER": (0.125, 0.6875), "MOT_SPIN_MIN": (0.0, 0.3),
+    "LAND_SPEED": (30.0, 200.0), "RC_DZ": (0.0, 200.0), "RC3_DZ": (0.0, 200.0), "ARM_DELAY_S": (0.0, 10.0),
+}
 
 
 @dataclass(frozen=True)
@@ -88,6 +103,15 @@ class SimParams:
     def __getitem__(self, name: str) -> float:
         return self.values[name]
 
+    def varied(self, e: Effects) -> SimParams:
+        """The same flight controller on an airframe whose mass, thrust, drag and motor lag the world varies."""
+        a = self.airframe
+        frame = dataclasses.replace(
+            a, mass_kg=a.mass_kg * e.mass_scale, motor_max_n=a.motor_max_n * e.thrust_scale,
+            drag_linear=a.drag_linear * e.drag_scale, drag_quadratic=a.drag_quadratic * e.drag_scale,
+            motor_tau_s=a.motor_tau_s * e.motor_tau_scale)
+        return dataclasses.replace(self, airframe=frame)
+
     def mode_number(self, pwm: float) -> int:
         """The ArduCopter mode number the flight-mode pulse selects (FLTMODE1..6; 0, Stabilize, by default)."""
         slot = 1 + sum(1 for bound in MODE_SLOT_BOUNDS_US if pwm > bound)
@@ -134,6 +158,7 @@ def load(parm: Path | None = REPO_PARM, overrides: Mapping[str, float] | None = 
     frame: dict[str, Any] = {k: (tuple(float(x) for x in v) if isinstance(v, list) else float(v))
                              for k, v in data["airframe"].items()}
     airframe = Airframe(**frame)
+    _check(values, airframe, source)
     sticks: dict[dp.ChannelName, Channel] = {}
     for name in STICKS:
         n = int(values.get(f"RCMAP_{name.value.upper()}", STICKS.index(name) + 1))
@@ -145,3 +170,15 @@ def load(parm: Path | None = REPO_PARM, overrides: Mapping[str, float] | None = 
         dz = values["RC3_DZ"] if name is dp.ChannelName.THROTTLE else values["RC_DZ"]
         sticks[name] = Channel(lo, hi, trim, bool(values.get(f"RC{n}_REVERSED", 0)), dz)
     return SimParams(values, airframe, sticks, source)
+
+
+def _check(values: Mapping[str, float], frame: Airframe, source: str) -> None:
+    """A figure outside its physical range (a negative mass, a dead band over the stick's travel) is refused."""
+    checks = [(f"airframe.{k}", getattr(frame, k), lo, hi, str(PARAMS_YAML)) for k, (lo, hi) in AIRFRAME_RANGES.items()]
+    checks += [(k, values[k], lo, hi, f"{PARAMS_YAML} or {source}") for k, (lo, hi) in PARAM_RANGES.items()
+               if k in values]
+    checks += [(f"airframe.inertia[{i}]", v, 1e-5, 100.0, str(PARAMS_YAML)) for i, v in enumerate(frame.inertia)]
+    for name, value, lo, hi, where in checks:
+        if not (math.isfinite(value) and lo <= value <= hi):
+            raise ConfigError(f"simulator parameter {name} = {value:g} ({where}): outside its physical range "
+                              f"{lo:g}..{hi:g}")

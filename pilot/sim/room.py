@@ -15,11 +15,16 @@ import zlib
 import numpy as np
 
 from ..common.errors import ConfigError
-from . import furnish
+from . import everyday, furnish, placement, randomise
 from .scenario import Ball, Interval, Light, MarkerPlate, Room, Scenario
 
 BASIC = ("ahead", "behind", "side", "high", "low", "hidden", "distractor")
 SCENARIOS = (*BASIC, "cluttered", "red_distractors", "dim", "backlit", "moving_target", "marker_edge", "occluded")
+# the target out of the 60-degree view at take-off (8 of the 14): behind, to the side, or anywhere 40-180 degrees off
+OUT_OF_VIEW = ("behind", "side", "high", "low", "hidden", "distractor", "cluttered", "red_distractors")
+WALLS: tuple[tuple[float, float, float], ...] = ((0.9, 0.88, 0.84), (0.7, 0.7, 0.7), (0.72, 0.42, 0.34))  # painted
+# white or grey, bare red brick
+FLOORS: tuple[tuple[float, float, float], ...] = ((0.7, 0.68, 0.62), (0.55, 0.5, 0.45), (0.62, 0.62, 0.64))
 
 
 def _rng(name: str, seed: int) -> np.random.Generator:
@@ -33,6 +38,8 @@ def _bearing(name: str, rng: np.random.Generator) -> float:
         return float(rng.choice([-1.0, 1.0])) * math.radians(float(rng.uniform(70.0, 110.0)))
     if name == "marker_edge":  # at the edge of the 60° view: the marker is cut by the frame's border
         return float(rng.choice([-1.0, 1.0])) * math.radians(float(rng.uniform(24.0, 29.0)))
+    if name in OUT_OF_VIEW:
+        return float(rng.choice([-1.0, 1.0])) * math.radians(float(rng.uniform(40.0, 180.0)))
     return math.radians(float(rng.uniform(-15.0, 15.0)))
 
 
@@ -54,13 +61,17 @@ def _lights(name: str, rng: np.random.Generator, noise: bool) -> tuple[tuple[Lig
 
 
 def make_scenario(
-    name: str, seed: int, *, noise: bool = True, marker: bool = True, max_wind: float = 0.0, gusts: float = 0.0
+    name: str, seed: int, *, noise: bool = True, marker: bool = True, max_wind: float = 0.0, gusts: float = 0.0,
+    ideal: bool = False,
 ) -> Scenario:
     """A named scenario; ``seed`` varies the start pose, the target's bearing, distance and height, the
     furniture, with ``noise`` the lighting, the sensor noise and the compression, and with ``max_wind`` (m/s) a
-    steady wind up to it and ``gusts`` (m/s) random gusts (both off by default: still air)."""
+    steady wind up to it and ``gusts`` (m/s) random gusts (both off by default: still air). ``ideal`` turns the
+    randomised world's effects off (``randomise.py``), the sensor noise too."""
     if name not in SCENARIOS:
         raise ConfigError(f"unknown scenario {name!r}; known: {', '.join(SCENARIOS)}")
+    effects = randomise.draw(name, seed, ideal=ideal)
+    noise = noise and not ideal
     rng = _rng(name, seed)
     room = Room()
     for _ in range(1000):
@@ -76,7 +87,9 @@ def make_scenario(
     else:  # pragma: no cover - the ranges above always leave room
         raise ConfigError(f"scenario {name!r} seed {seed}: no valid placement")
     tz = {"high": (2.0, 2.3), "low": (0.35, 0.5)}.get(name, (1.0, 1.6))
-    target = Ball((tx, ty, float(rng.uniform(*tz))), 0.15)
+    # a ball sold as 30 cm (27-33 cm as bought and inflated), of a red between crimson and tomato
+    shade = (float(rng.uniform(0.7, 0.9)), float(rng.uniform(0.04, 0.14)), float(rng.uniform(0.04, 0.12)))
+    target = Ball((tx, ty, float(rng.uniform(*tz))), float(rng.uniform(0.135, 0.165)), shade)
     facing = math.atan2(sy - ty, sx - tx)  # the plate faces the start
     # the plate hangs on the target's pole, below the ball (above it for a low target)
     plate_z = target.position[2] - 0.45 if target.position[2] >= 1.0 else target.position[2] + 0.45
@@ -89,6 +102,7 @@ def make_scenario(
         props += furnish.red_things(place)
     if name == "occluded":
         props += furnish.occluder(place, target.position, target.radius)
+    props += everyday.near_target(place, int(rng.integers(2, 4)))
     hidden: tuple[Interval, ...] = ()
     if name == "hidden":
         begin = float(rng.uniform(8.0, 11.0))
@@ -102,7 +116,7 @@ def make_scenario(
     wind_speed = float(rng.uniform(0.0, 1.0)) * max_wind
     wind_dir = float(rng.uniform(-math.pi, math.pi))
     dim = name == "dim"
-    return Scenario(
+    built = Scenario(
         name=name,
         seed=seed,
         room=room,
@@ -116,10 +130,16 @@ def make_scenario(
         ambient=ambient,
         wall_texture=str(rng.choice(furnish.WALL_TEXTURES)),
         floor_texture=str(rng.choice(furnish.FLOOR_TEXTURES)),
+        wall_rgb=WALLS[int(rng.integers(0, len(WALLS)))],
+        floor_rgb=FLOORS[int(rng.integers(0, len(FLOORS)))],
         window=name == "backlit",
-        exposure_s=(1.0 / 30.0 if dim else float(rng.uniform(1.0 / 200.0, 1.0 / 80.0))) if noise else 1.0 / 500.0,
+        # indoors under room light a camera's auto-exposure sits at 1/120-1/40 s (1/30 s when dim)
+        exposure_s=(1.0 / 30.0 if dim else float(rng.uniform(1.0 / 120.0, 1.0 / 40.0))) if noise else 1.0 / 500.0,
         noise_sigma=(float(rng.uniform(2.0, 5.0)) if noise else 0.0) * (2.5 if dim else 1.0),
         jpeg_quality=int(rng.integers(70, 95)) if noise else 95,
         wind=(wind_speed * math.cos(wind_dir), wind_speed * math.sin(wind_dir)),
         gusts=gusts,
+        effects=effects,
     )
+    placement.check(built)
+    return built

@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from .randomise import IDEAL, Effects
+
 Vec3 = tuple[float, float, float]
 RGB = tuple[float, float, float]
 BGR = tuple[int, int, int]
@@ -102,8 +104,10 @@ class Scenario:
     target_motion: Vec3 = (0.0, 0.0, 1.0)  # amplitude (m) along x, along y, period (s): a moving target
     lights: tuple[Light, ...] = ()
     ambient: float = 0.3
-    wall_texture: str = "brick"
+    wall_texture: str = "brick"  # a photograph of textures.SURFACES, drawn at its real scale
     floor_texture: str = "gravel"
+    wall_rgb: RGB = (0.85, 0.82, 0.78)  # the photograph's tint: painted or bare brick, concrete's shade
+    floor_rgb: RGB = (0.7, 0.68, 0.62)
     window: bool = False  # a bright window on the wall behind the target (backlit)
     exposure_s: float = 1.0 / 120.0  # the camera's exposure time: motion blur
     noise_sigma: float = 0.0  # sensor noise at unit gain
@@ -111,6 +115,7 @@ class Scenario:
     wind: tuple[float, float] = (0.0, 0.0)  # steady wind, m/s along x and y
     gusts: float = 0.0  # gust strength, m/s (a seeded random process)
     time_budget_s: float = 60.0
+    effects: Effects = IDEAL  # the randomised world's imperfections (randomise.py)
     wall_margin: float = field(default=0.25)  # the drone's radius
 
     def target_visible(self, t: float) -> bool:

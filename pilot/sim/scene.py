@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from . import textures
+from . import placement, textures
 from .rc import Airframe
 from .scenario import Prop, Scenario
 
@@ -18,6 +18,7 @@ HIDDEN_GROUP = 4
 CAMERA_POS = (0.23, 0.0, -0.03)  # on the airframe's nose, below the arms
 ZNEAR = 0.001  # the camera's near clipping plane, in the room's extents (about 1 cm): at MuJoCo's 0.01 (11 cm), a
 # wall within 9 cm of the airframe's nose vanished, and the camera saw the black outside the room
+SHADOW_MAP_PX = 1024  # the shadow map's side: MuJoCo's 4096 costs the software renderer more for no visible gain
 MOTOR_SPIN = (1, -1, 1, -1)  # front-left, front-right... alternating directions cancel the reaction torque
 
 
@@ -68,6 +69,18 @@ class _Writer:
                               f'rgba="{rgba}"/>')
         return name
 
+    def surface_material(self, surface: str, rgb: tuple[float, float, float]) -> str:
+        """A wall or floor photograph repeated at its real scale (MuJoCo's texuniform: repeats per metre)."""
+        name = f"surface_{surface}_{len(self.materials)}"
+        file = f"surface_{surface}.png"
+        if file not in self.assets:
+            self.assets[file] = textures.surface(surface)
+            self.materials.append(f'<texture name="tex_surface_{surface}" type="2d" file="{file}"/>')
+        per_m = 1.0 / textures.SURFACES[surface].metres
+        self.materials.append(f'<material name="{name}" texture="tex_surface_{surface}" texuniform="true" '
+                              f'texrepeat="{_f(per_m, per_m)}" rgba="{_f(*rgb, 1.0)}" specular="0.1"/>')
+        return name
+
     def colour_material(self, name: str, rgb: tuple[float, float, float], emission: float = 0.0) -> str:
         self.materials.append(f'<material name="{name}" rgba="{_f(*rgb, 1.0)}" emission="{emission:g}" '
                               f'specular="0.2" shininess="0.3"/>')
@@ -86,9 +99,10 @@ class _Writer:
 
 def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg: float) -> Built:
     sc, room = scenario, scenario.room
+    placement.check(sc)  # a spawn or target in a wall or a piece of furniture is refused, never flown
     w = _Writer()
-    walls = w.photo_material(sc.wall_texture, (4.0, 1.5), "0.85 0.82 0.78 1")
-    floor = w.photo_material(sc.floor_texture, (6.0, 5.0), "0.7 0.68 0.62 1")
+    walls = w.surface_material(sc.wall_texture, sc.wall_rgb)
+    floor = w.surface_material(sc.floor_texture, sc.floor_rgb)
     ceiling = w.colour_material("ceiling", (0.88, 0.88, 0.86))
     target = w.colour_material("target", sc.target.rgb)
     pole = w.colour_material("pole", (0.42, 0.42, 0.42))
@@ -128,8 +142,9 @@ def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg
         bx, by = 0.022 * math.cos(f), 0.022 * math.sin(f)
         target_geoms.append(f'<geom name="target_backing" type="box" pos="{_f(bx, by, plate.centre[2])}" '
                             f'quat="{_yaw_quat(f)}" size="{_f(0.008, half, half)}" material="{pole}"/>')
+    shadows = "true" if sc.effects.shadows else "false"
     lights = [f'<light name="light_{i}" pos="{_f(*lt.position)}" dir="{_f(*lt.direction)}" '
-              f'diffuse="{_f(*lt.rgb)}" specular="0.1 0.1 0.1" castshadow="false" attenuation="1 0 0"/>'
+              f'diffuse="{_f(*lt.rgb)}" specular="0.1 0.1 0.1" castshadow="{shadows}" attenuation="1 0 0"/>'
               for i, lt in enumerate(sc.lights)]
     motors = motor_positions(frame.arm_m)
     sites = "\n".join(f'      <site name="motor_{i}" pos="{_f(x, y, 0.02)}" size="0.01" group="{DRONE_GROUP}"/>'
@@ -141,15 +156,15 @@ def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg
     sx, sy, heading = sc.start
     ix, iy, iz = frame.inertia
     amb = sc.ambient
-    # no shadows and no multisampling: MSAA doubled the software renderer's cost (5 -> 10 ms at 320x240), and
-    # the sensor's JPEG and motion blur soften the edges anyway
+    # no multisampling: MSAA doubled the software renderer's cost (5 -> 10 ms at 320x240), and the sensor's JPEG
+    # and motion blur soften the edges anyway; shadows (the randomised world's) from a SHADOW_MAP_PX map
     xml = f"""<mujoco model="room">
   <compiler angle="radian"/>
   <option timestep="0.002"/>
   <visual>
     <global offwidth="{width}" offheight="{height}"/>
     <headlight ambient="{_f(amb, amb, amb)}" diffuse="0 0 0" specular="0 0 0"/>
-    <quality shadowsize="0" offsamples="0"/>
+    <quality shadowsize="{SHADOW_MAP_PX if sc.effects.shadows else 0}" offsamples="0"/>
     <map znear="{ZNEAR}"/>
   </visual>
   <asset>
@@ -192,4 +207,13 @@ def _window(w: _Writer, sc: Scenario) -> str:
     on_x_wall = abs(t - ts[0]) < 1e-9  # the line meets a wall of constant x first
     heading = (math.pi if dx > 0 else 0.0) if on_x_wall else (-math.pi / 2 if dy > 0 else math.pi / 2)
     mat = w.colour_material("window", (1.0, 0.98, 0.92), emission=2.5)
-    return _wall_plane("window", x, y, 1.6, heading, (1.0, 0.8), mat, offset=0.02, solid=False)
+    frame = w.colour_material("window_frame", (0.85, 0.85, 0.82))
+    # the pane, then its frame and a cross of glazing bars in front of it (the bars cut the backlight as a
+    # real window's do)
+    along = (-math.sin(heading), math.cos(heading))
+    parts = [_wall_plane("window", x, y, 1.6, heading, (1.0, 0.8), mat, offset=0.02, solid=False)]
+    for i, (u, z, half) in enumerate(((0.0, 1.6, (0.03, 0.8)), (0.0, 1.6, (1.0, 0.03)), (-1.0, 1.6, (0.05, 0.85)),
+                                      (1.0, 1.6, (0.05, 0.85)), (0.0, 0.8, (1.05, 0.05)), (0.0, 2.4, (1.05, 0.05)))):
+        parts.append(_wall_plane(f"window_bar_{i}", x + u * along[0], y + u * along[1], z, heading, half, frame,
+                                 offset=0.025, solid=False))
+    return "\n    ".join(parts)

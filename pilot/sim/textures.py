@@ -1,9 +1,13 @@
 """The simulator's images, as PNG bytes for MuJoCo's asset table: photographs shipped inside scikit-image's
-wheel (nothing is downloaded at run time), the ArUco marker, and plain colours."""
+wheel (nothing is downloaded at run time), the ArUco marker, and plain colours.
+
+``SURFACES`` are the photographs that cover walls and floors, each with the width it shows in metres, so that
+the room draws them at their real scale (a brick course 75 mm high, gravel of 1-2 cm)."""
 
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -12,6 +16,32 @@ import numpy.typing as npt
 from .scenario import MarkerPlate
 
 Image = npt.NDArray[np.uint8]
+
+
+@dataclass(frozen=True)
+class Surface:
+    photo: str  # scikit-image's name
+    metres: float  # the real width the photograph shows
+    turn: bool = False  # a quarter turn (the brick photograph's courses run up the image)
+
+
+# brick.png: 512 px across 9.5 courses of 65 mm bricks and 10 mm joints (0.72 m); gravel.png: 512 px across about
+# 35 stones of 10-20 mm (0.5 m)
+SURFACES = {"brick": Surface("brick", 0.72, turn=True), "gravel": Surface("gravel", 0.5)}
+
+
+@functools.cache
+def surface(name: str) -> bytes:
+    """A wall or floor photograph at its full resolution (512 px), turned so that it lies as it stood."""
+    import skimage.data
+
+    s = SURFACES[name]
+    img = np.asarray(getattr(skimage.data, s.photo)(), dtype=np.uint8)
+    if s.turn:
+        img = np.ascontiguousarray(np.rot90(img))
+    if img.ndim == 2:
+        img = np.stack([img] * 3, axis=-1)
+    return _png(np.asarray(img[..., :3], dtype=np.uint8))
 
 
 @functools.cache

@@ -22,6 +22,7 @@ from ..common.errors import FrameSourceError, SimulatorError
 from ..vision.sources import Frame, FrameSourceBase
 from . import mj, rc
 from .camera import CameraModel, Image, Sensor
+from .latency import FrameTiming, History, Pose, Servos
 from .physics import Airframe, AirframeState
 from .scenario import Scenario
 from .scene import DRONE_GROUP, HIDDEN_GROUP, build
@@ -42,8 +43,10 @@ class FlightScore:
     reached: bool = False  # came within reach
     path: list[tuple[float, float, float, float]] = field(default_factory=list)  # t, x, y, z
     max_altitude: float = 0.0
-    physics_ms: float = 0.0  # wall time in physics and control
-    render_ms: float = 0.0  # wall time in MuJoCo's renderer
+    # the simulator's cost, in CPU time (the process's, all its threads): the machine's other load does not count
+    physics_ms: float = 0.0  # physics, control and estimation
+    render_ms: float = 0.0  # MuJoCo's renderer (and posing the past for it)
+    sensor_ms: float = 0.0  # the sensor's effects
     frames: int = 0
 
 
@@ -74,7 +77,7 @@ class SimWorld(Closing):
         self.scenario = scenario
         self.vd = vd
         self.camera_model = camera or CameraModel()
-        self.params = params or rc.load()
+        self.params = (params or rc.load()).varied(scenario.effects)
         built = build(scenario, self.params.airframe, self.camera_model.width, self.camera_model.height,
                       self.camera_model.fovy_deg)
         try:
@@ -104,6 +107,12 @@ class SimWorld(Closing):
         self.changes_seen = len(changes)
         self._t_ms = vd.t_ms
         self.sensor.aim(self.outputs.pan, self.outputs.tilt)
+        effects = scenario.effects
+        self.servos = Servos(effects, self.outputs.pan, self.outputs.tilt)
+        self.timing = FrameTiming(effects, scenario.seed)
+        self.history = (History(self.timing.keep_s, STEP_MS)
+                        if effects.frame_latency_s > 0.0 or effects.frame_drop > 0.0 else None)
+        self._remember()
         self._record_path()
 
     @property
@@ -128,20 +137,23 @@ class SimWorld(Closing):
         pending = list(changes)
         end = self.vd.t_ms
         outputs = self.outputs
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         while self._t_ms + STEP_MS <= end:
             while pending and pending[0].t_ms <= self._t_ms:
                 outputs = pending.pop(0).outputs
-                self.sensor.aim(outputs.pan, outputs.tilt)
+            if self.servos.step(outputs.pan, outputs.tilt, STEP_MS / 1000.0):
+                self.sensor.aim(self.servos.pan, self.servos.tilt)
             self.airframe.step(outputs.pulses, STEP_MS / 1000.0)
             self._t_ms += STEP_MS
+            self._remember()
             self._score(outputs, STEP_MS)
         for change in pending:
             outputs = change.outputs
         self.outputs = outputs
-        self.sensor.aim(outputs.pan, outputs.tilt)
+        if self.servos.step(outputs.pan, outputs.tilt, 0.0):  # ideal servos follow a change at the tick's end
+            self.sensor.aim(self.servos.pan, self.servos.tilt)
         self.fw_state = self.vd.state
-        self.score.physics_ms += (time.perf_counter() - t0) * 1000.0
+        self.score.physics_ms += (time.process_time() - t0) * 1000.0
         self._record_path()
 
     def _await_replies(self, link: PortCounts) -> None:
@@ -156,10 +168,35 @@ class SimWorld(Closing):
 
     # -- the camera -----------------------------------------------------------------------------
     def render(self) -> Image:
-        img = self.sensor.render(self.now())
-        self.score.render_ms += self.sensor.render_ms
+        """The frame the pilot reads now: the room as it was at the frame's exposure (``latency.py``)."""
+        t0 = time.process_time()
+        t = self.timing.exposure(self.now())
+        pose = None if self.history is None else self.history.at(t * 1000.0)
+        img = self.sensor.render(self.now()) if pose is None else self._render_past(pose, t)
+        self.score.sensor_ms += self.sensor.sensor_ms
+        self.score.render_ms += (time.process_time() - t0) * 1000.0 - self.sensor.sensor_ms
         self.score.frames += 1
         return img
+
+    def _render_past(self, pose: Pose, t: float) -> Image:
+        """Render from ``pose`` (the airframe, the target and the mount then), then put the present back."""
+        mujoco, d = mj.module(), self.mj_data
+        qpos, mocap = d.qpos.copy(), d.mocap_pos.copy()
+        d.qpos[:], d.mocap_pos[:] = pose.qpos, pose.mocap
+        mujoco.mj_kinematics(self.mj_model, d)
+        self.sensor.aim(pose.pan, pose.tilt)
+        try:
+            return self.sensor.render(t)
+        finally:
+            d.qpos[:], d.mocap_pos[:] = qpos, mocap
+            mujoco.mj_kinematics(self.mj_model, d)
+            self.sensor.aim(self.servos.pan, self.servos.tilt)
+
+    def _remember(self) -> None:
+        if self.history is not None:
+            d = self.mj_data
+            self.history.record(Pose(self._t_ms, d.qpos.copy(), d.mocap_pos.copy(), self.servos.pan,
+                                     self.servos.tilt))
 
     def camera(self) -> SimCamera:
         return SimCamera(self)

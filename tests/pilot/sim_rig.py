@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import drone_protocol as dp
 
 from pilot.sim import mj, rc
 from pilot.sim.physics import Airframe
+from pilot.sim.randomise import IDEAL, Effects
 from pilot.sim.room import make_scenario
 from pilot.sim.scene import build
 
@@ -19,13 +22,14 @@ MEDIANS = {n: float(CH[dp.ChannelName(n)].median) for n in ("roll", "pitch", "th
 class Rig:
     """The airframe alone in a scenario's room, driven by pulses."""
 
-    def __init__(self, name: str = "ahead", seed: int = 0) -> None:
+    def __init__(self, name: str = "ahead", seed: int = 0, effects: Effects = IDEAL) -> None:
         mujoco = mj.module()
-        sc = make_scenario(name, seed, noise=False)
-        built = build(sc, PARAMS.airframe, 64, 48, 45.0)
+        sc = dataclasses.replace(make_scenario(name, seed, ideal=True), effects=effects)
+        params = PARAMS.varied(effects)
+        built = build(sc, params.airframe, 64, 48, 45.0)
         self.model = mujoco.MjModel.from_xml_string(built.xml, built.assets)
         self.data = mujoco.MjData(self.model)
-        self.af = Airframe(sc, PARAMS, self.model, self.data)
+        self.af = Airframe(sc, params, self.model, self.data)
 
     def run(self, seconds: float, mode: float = ALT_HOLD, **sticks: float) -> None:
         p = {**MEDIANS, **sticks}

@@ -245,8 +245,8 @@ def _touches(rig: Rig, x: float, y: float, z: float) -> set[str]:
 
 def test_the_marker_plate_and_the_pictures_are_touched_only_where_they_are() -> None:
     """MuJoCo collides with a plane as an infinite half-space: the marker's plane once made a wall of the whole
-    room behind the target. Beside the plate along its plane, and behind it, there is nothing; at the plate, its
-    backing board."""
+    room behind the target. Beside the plate along its plane, and behind it, nothing of the target (the room's
+    everyday things may stand there); at the plate, its backing board."""
     rig = Rig("ahead", 0)
     sc = rig.af.sc
     assert sc.marker is not None
@@ -257,7 +257,7 @@ def test_the_marker_plate_and_the_pictures_are_touched_only_where_they_are() -> 
     behind = (px - 1.0 * normal[0], py - 1.0 * normal[1])
     for x, y in (*beside, behind):
         assert sc.room.inside(x, y, 0.4)  # clear of the walls, so that any contact is the plate's
-        assert _touches(rig, x, y, pz) == set()
+        assert {n for n in _touches(rig, x, y, pz) if n.startswith("target")} == set()
     # the airframe's front edge reaching the board
     reach = PARAMS.airframe.radius_m + 0.02
     assert "target_backing" in _touches(rig, px + reach * normal[0], py + reach * normal[1], pz)
