@@ -39,7 +39,7 @@ States (``State``)::
   frames FIRE switches the laser on (not while the detector sees something else at the aim point: a thing in
   front of the target hides its middle while the circle through its rim stays centred). The laser stays on only
   while the target is found, centred, in range and clear at the aim point;
-  after ``fire_ms`` lit (as the drone confirmed it) it is switched off and the drone lands. While
+  after ``fire_ms`` lit without a break (as the drone confirmed it) it is switched off and the drone lands. While
   firing, small errors (within twice the aim tolerance) are still corrected
   with the servos; larger ones switch the laser off and go back to AIM.
 * Losing the target (``lost_frames`` misses in a row) in ACQUIRE/TRACK/AIM/FIRE: laser off, sticks
@@ -373,6 +373,7 @@ class Controller(ControllerCore):
         if det is None or not self._found(det):
             self._misses += 1
             off = self._laser(False)  # never lit without a lock
+            self.lit_ms = 0  # the fire time is one unbroken stay on the target: it starts again
             if self._misses >= self.cfg.lost_frames:
                 self._go(State.SEARCH, "target lost while firing")
             return off if off is not None else self._emit(dp.hold_altitude())
@@ -388,6 +389,7 @@ class Controller(ControllerCore):
             return off if off is not None else self._on_aim(det)
         if not self.gate.confirmed():  # vision gate: found, but not confirmed in enough frames in a row
             off = self._laser(False)
+            self.lit_ms = 0
             return off if off is not None else self._emit(dp.hold_altitude())
         on = self._laser(True)
         if on is not None:
