@@ -156,3 +156,31 @@ def test_a_camera_that_stays_dark_lands_the_drone(faulty: dict[str, FlightResult
     assert r.landed_because == "camera: saturated frames", r.summary()
     assert not r.success and r.lit_on_target_ms == 0 and r.lit_during_fault_ms == 0
     assert not r.final_laser and not r.final_fc_armed and r.final_altitude < 0.02 and r.crashes == 0, r.summary()
+
+
+def _row(scenario: str, seed: int, detector: str, success: bool, t: float | None, sim: float = 30.0,
+         failed: tuple[str, ...] = (), gusts: float = 0.0) -> dict[str, object]:
+    return {"scenario": scenario, "seed": seed, "detector": detector, "success": success, "time_to_target_s": t,
+            "sim_seconds": sim, "failures": list(failed), "gusts": gusts, "non_target_hits": 0, "wall_hits": 0,
+            "crashes": 0, "final_laser": False, "final_fc_armed": False, "final_armed": False}
+
+
+def test_the_campaign_tables_count_strict_successes_reasons_and_step_ratios() -> None:
+    """bench/flight's held-out seeds, its table (median time to target), failure reasons and the step comparison."""
+    from bench.flight.run import held_out_jobs
+    from bench.flight.strict import HELD_OUT_GUSTS, HELD_OUT_STILL, compare, reasons, table
+
+    jobs = held_out_jobs(2, 1, None, ("hsv", "aruco"))
+    assert {j.seed for j in jobs if not j.gusts} == {HELD_OUT_STILL, HELD_OUT_STILL + 1}
+    assert {j.seed for j in jobs if j.gusts} == {HELD_OUT_GUSTS} and len(jobs) == 14 * 5
+    assert [j.detector for j in jobs[:3]] == ["hsv", "aruco", "hsv"]  # seed by seed: a campaign cut short is balanced
+    late = "spot on the target 40 ms at most without a break (fire time 1500 ms)"
+    base = [_row("ahead", 1, "hsv", True, 10.0), _row("side", 1, "hsv", True, 14.0),
+            _row("dim", 1, "hsv", False, None, 60.0, (late, "the fire did not complete"))]
+    assert table(base)[2] == "| hsv | 2/3 (66.7 %) | 12.0 | 0 | 0/3 (0.0 %) | 0 | 3/3 (100.0 %) |"
+    assert reasons(base) == ["- spot on the target N ms at most without a break (fire time N ms): 1",
+                             "- the fire did not complete: 1"]
+    stepped = [_row("ahead", 1, "hsv", True, 12.0), _row("side", 1, "hsv", True, 28.0),
+               _row("dim", 1, "hsv", False, None, 60.0)]
+    assert compare(stepped, base) == ["Against the same seeds at the shipped step (3 flights): 2/3 (66.7 %) within "
+                                      "1.5x its time; median ratio 1.20, worst 2.00 (side 1)."]
