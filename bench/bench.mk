@@ -23,6 +23,8 @@
 #                         simulator's cost per frame; writes bench/flight/RESULTS.md (BENCH_FLIGHT_FLAGS=--seeds 2
 #                         for a shorter one; "--detector hsv --first-seed 500 --seeds 4": seeds never tuned on,
 #                         bench/flight/RESULTS-hsv-from500.md)
+#   make bench-flight-strict  the strict campaign on held-out seeds (both detectors, gusts), then HSV with speed
+#                         steps of 150 and 70 µs; bench/flight/RESULTS-held-out.md, RESULTS-step150.md, -step70.md
 #   make bench            every part's benchmark: bench-protocol, bench-generator, bench-firmware
 #                         (firmware/firmware.mk), bench-pilot (pilot/pilot.mk), bench-vision, bench-ide
 #                         (bench/ide/bench.mk), bench-rust-c (tests/targets/targets.mk) and bench-tools
@@ -37,7 +39,7 @@ VISION_DEV_RECORD ?= current
 BENCH_FLIGHT_FLAGS ?=
 
 .PHONY: bench bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-vision-dev bench-ide bench-tools \
-        bench-flight
+        bench-flight bench-flight-strict
 
 # Run benchmarks one at a time (not with make -j): they time each other otherwise.
 bench: bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-ide bench-rust-c bench-tools \
@@ -45,6 +47,14 @@ bench: bench-protocol bench-generator bench-firmware bench-pilot bench-vision be
 
 bench-flight: deps firmware-host
 	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.flight.run $(BENCH_FLIGHT_FLAGS)
+
+# The strict campaign on held-out seeds (11 seeds x 14 scenarios = 154 flights per detector, gusts too), then the
+# HSV flights again with speed steps of 150 and 70 µs: bench/flight/RESULTS-held-out.md, RESULTS-step150.md, -step70.md
+BENCH_FLIGHT_STRICT_FLAGS ?= --seeds 11 --gust-seeds 4 --processes 2
+bench-flight-strict: deps firmware-host
+	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.flight.run --held-out $(BENCH_FLIGHT_STRICT_FLAGS)
+	for step in 150 70; do PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.flight.run --held-out \
+	  --step-us $$step $(BENCH_FLIGHT_STRICT_FLAGS) || exit 1; done
 
 bench-vision: deps
 	PYTHONPATH=.:bench/vision $(PY) bench/vision/run.py $(BENCH_VISION_FLAGS)

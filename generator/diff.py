@@ -1,9 +1,10 @@
 """What changed between two versions of the protocol, and which changes break a peer built from the old one.
 
 Both versions are reduced to a contract: the facts a peer relies on (frame layout, link, command codes and
-their ranges and meaning, error and reply codes, timing) plus the texts. The generator writes the contract of
-what it generated to generated/contract.json, so the next generation (and `--check`) can tell a breaking edit
-whose protocol.version did not rise, without git or the old spec file.
+their ranges and meaning, error and reply codes, timing, and how the drone flies: the speed step and the flight
+controller's parameters, any change of which needs them loaded again) plus the texts. The generator writes the
+contract of what it generated to generated/contract.json, so the next generation (and `--check`) can tell a
+breaking edit whose protocol.version did not rise, without git or the old spec file.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from .ardupilot import parameters
 from .model import Spec
 
 Contract = dict[str, Any]
@@ -45,6 +47,10 @@ def contract(spec: Spec) -> Contract:
         "states": {st.name: {"code": st.code, "armed": st.armed, "description": st.description}
                    for st in spec.status.states},
         "texts": {"title": spec.title, "description": spec.description},
+        # how the drone flies: the speed step (the firmware's default speeds and its landing descent) and the
+        # parameters the flight controller must be loaded with (generated/ardupilot/drone.parm)
+        "flight": {"step_us": spec.speed_step_us},
+        "flight_controller": {p.name: p.value for p in parameters(spec)},
     }
 
 
@@ -63,7 +69,7 @@ def contract_problem(found: object) -> str | None:
         return "it is not a mapping"
     if not isinstance(found.get("name"), str) or type(found.get("version")) is not int:
         return "its name or its integer version is missing"
-    for section in ("frame", "link", "status", "timing", "texts", *_ENTRIES):
+    for section in ("frame", "link", "status", "timing", "texts", "flight", "flight_controller", *_ENTRIES):
         if not isinstance(found.get(section, {}), dict):
             return f"{section} is not a mapping"
     for table, keys in _ENTRIES.items():
@@ -96,6 +102,7 @@ def diff(old: Contract, new: Contract) -> list[Change]:
     _entries(old, new, "errors", changes, _keyed_change("error", "code"))
     _entries(old, new, "replies", changes, _keyed_change("reply", "prefix"))
     _entries(old, new, "states", changes, _keyed_change("state", "code", "armed"))
+    _flight_controller(old, new, changes)
     old_names = {c["name"]: code for code, c in old.get("commands", {}).items()}
     for code, cmd in new.get("commands", {}).items():
         was = old.get("commands", {}).get(code)
@@ -113,7 +120,7 @@ _TOLERANT = {("frame", "inter_byte_timeout_ms"): "rise", ("link", "ready_timeout
 
 
 def _sections(old: Contract, new: Contract, changes: list[Change]) -> None:
-    for section in ("frame", "link", "status", "timing", "texts"):
+    for section in ("frame", "link", "status", "timing", "texts", "flight"):
         if section not in old or section not in new:
             continue  # a contract written before the section existed: nothing to compare
         before, after = old[section], new[section]
@@ -121,10 +128,26 @@ def _sections(old: Contract, new: Contract, changes: list[Change]) -> None:
             a, b = before[key], after.get(key)
             if a == b:
                 continue
-            rule = "any" if section == "texts" else _TOLERANT.get((section, key), "never")
+            rule = "any" if section in ("texts", "flight") else _TOLERANT.get((section, key), "never")
             rose = isinstance(a, int) and isinstance(b, int) and b > a
             breaking = rule == "never" or (rule == "rise" and not rose)
-            changes.append(Change(breaking, f"{section}.{key}: {a!r} -> {b!r}"))
+            note = " (how the drone flies: the default speeds and the landing descent)" if section == "flight" else ""
+            changes.append(Change(breaking, f"{section}.{key}: {a!r} -> {b!r}{note}"))
+
+
+def _flight_controller(old: Contract, new: Contract, changes: list[Change]) -> None:
+    """Any change to the flight controller's parameters breaks a drone loaded with the old ones: it flies
+    otherwise (a dead band, a reversed stick, a range) until generated/ardupilot/drone.parm is loaded again."""
+    if "flight_controller" not in old or "flight_controller" not in new:
+        return  # a contract written before the section existed
+    before, after = old["flight_controller"], new["flight_controller"]
+    reload = "re-load generated/ardupilot/drone.parm into the flight controller"
+    for name in sorted(set(before) | set(after)):
+        a, b = before.get(name), after.get(name)
+        if a != b:
+            was = "unset" if a is None else repr(a)
+            now = "unset (ArduCopter's default)" if b is None else repr(b)
+            changes.append(Change(True, f"flight_controller.{name}: {was} -> {now} ({reload})"))
 
 
 def _entries(old: Contract, new: Contract, section: str, changes: list[Change],

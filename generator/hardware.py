@@ -24,10 +24,14 @@ def read(top: Reader, channels: dict[str, Channel], servo_names: list[str], fail
     return project, wiring
 
 
-def flight_controller(top: Reader, channels: dict[str, Channel]) -> FlightControllerSetup:
+def flight_controller(top: Reader, channels: dict[str, Channel], step_us: int) -> FlightControllerSetup:
     """The optional `flight_controller` section: ArduCopter's defaults when it is absent."""
     node = top.child("flight_controller", required=False)
     if node is None:
+        step_node = top.node.children["speeds"].children.get("step_us") if top.ok and "speeds" in top.node.children \
+            else None
+        if step_node is not None:
+            _check_dead_band(top, step_node, "speeds.step_us", THR_DZ_DEFAULT, channels, step_us)
         return FlightControllerSetup((), THR_DZ_DEFAULT)
     r = Reader(node, "flight_controller", top.errors)
     names: list[str] = []
@@ -50,8 +54,31 @@ def flight_controller(top: Reader, channels: dict[str, Channel]) -> FlightContro
         assert dz_node is not None
         r.error(dz_node, f"throttle_dead_band {dead_band} is not in {THR_DZ_RANGE[0]}..{THR_DZ_RANGE[1]}",
                 "ArduCopter's THR_DZ range", path=r.sub("throttle_dead_band"))
+    elif is_int(dz_node):
+        assert dz_node is not None
+        _check_dead_band(r, dz_node, r.sub("throttle_dead_band"), dead_band, channels, step_us)
     r.finish()
     return FlightControllerSetup(tuple(names), dead_band)
+
+
+def _check_dead_band(r: Reader, node: Node, path: str, dead_band: int, channels: dict[str, Channel],
+                     step_us: int) -> None:
+    """AltHold's throttle dead band (THR_DZ, 0-1000 of the throttle's range) must be narrower than the speed step:
+    a climb or descent at the step would not move the drone, nor would the landing routine's descent."""
+    throttle = channels.get("throttle")
+    if throttle is None or step_us <= 0:
+        return
+    span = throttle.recorded_max - throttle.recorded_min
+    dead_us = dead_band * span / 1000.0
+    if dead_us >= step_us:
+        widest = max(0, -(-step_us * 1000 // span) - 1)  # the widest band still narrower than the step
+        default = path == "speeds.step_us"
+        what = f"ArduCopter's default throttle dead band {dead_band}" if default else f"throttle_dead_band {dead_band}"
+        r.error(node, f"{what} is {dead_us:.0f} µs of the throttle's {span} µs, as wide as the speed step "
+                f"({step_us} µs) or wider: a move up or down at the step, and the landing routine's descent, would "
+                "not move the drone",
+                f"set flight_controller.throttle_dead_band to at most {widest} (ArduCopter's THR_DZ), or raise "
+                "speeds.step_us", path=path)
 
 
 def _project(r: Reader) -> Project:

@@ -8,7 +8,8 @@ millisecond by millisecond against the pilot's state at that moment:
   during it; the excess beyond that is the figure (goal 0 ms);
 * arming-state disagreements: intervals where the pilot's view (from the replies' status) says armed and the
   firmware is not, or the reverse (count, longest; goal: none over 200 ms);
-* flights completed: target reached and lit, and the run ended with the drone confirming laser off and disarmed.
+* flights completed: the spot on the target without a break for the fire time, the fire completed, and the run
+  ended with the drone confirming laser off and disarmed.
 
 With ``--integrity crc8`` a copy of the spec with ``frame.integrity: crc8`` is generated into a temporary folder,
 the virtual drone is built from it, and the flights run in a child process that imports that codec.
@@ -34,7 +35,6 @@ import drone_protocol as dp
 
 from bench.lossy.proxy import LossyProxy
 from pilot.app.runner import run
-from pilot.app.sim_flight import SUCCESS_LIT_MS
 from pilot.common.config import PilotConfig
 from pilot.control.controller import Controller
 from pilot.link.serial_link import Link, keepalive_ms
@@ -163,7 +163,7 @@ def fly(job: tuple[str, int, float, str, str]) -> FlightFigures:
                 world.advance(dp.FAILSAFE_TIMEOUT_MS + tick_ms)
             meter.finish(vd.t_ms)
             score = world.score
-            figures.lit = score.lit_on_target_ms >= SUCCESS_LIT_MS and score.reached
+            figures.lit = score.longest_on_target_ms >= cfg.controller.fire_ms and result.fired  # strict: unbroken
             figures.ended_safe = result.safe and not world.outputs.laser and not world.outputs.armed
             figures.completed = figures.lit and figures.ended_safe
             figures.damages = len(proxy.damages)

@@ -26,7 +26,35 @@ from ..vision.detect import make_detector
 from .record import Recorder
 from .runner import Observer, run
 
-SUCCESS_LIT_MS = 500  # laser on the target, within reach, for at least this long
+
+def failures(*, fire_ms: int, longest_on_target_ms: int, fired: bool, non_target_hits: int, what: Sequence[str],
+             wall_hits: int, crashes: int, landed_disarmed: bool, laser_off: bool,
+             error: str | None) -> tuple[str, ...]:
+    """Why a flight failed (nothing: it succeeded). A success keeps the laser spot on the target without a break
+    for the fire time, completes the fire, lights nothing else, touches no wall, and ends landed and disarmed."""
+    out: list[str] = []
+    if longest_on_target_ms < fire_ms:
+        out.append(f"spot on the target {longest_on_target_ms} ms at most without a break (fire time {fire_ms} ms)")
+    if not fired:
+        out.append("the fire did not complete")
+    if non_target_hits:
+        out.append(f"{non_target_hits} non-target hit(s) ({', '.join(what)})")
+    if wall_hits:
+        out.append(f"{wall_hits} wall touch(es)")
+    if crashes:
+        out.append(f"{crashes} crash(es)")
+    if not landed_disarmed:
+        out.append("did not land and disarm")
+    if not laser_off:
+        out.append("laser left on")
+    if error:
+        out.append(f"pilot stopped by {error}")
+    return tuple(out)
+
+
+def time_to_target(runs: Sequence[Sequence[int]], fire_ms: int) -> float | None:
+    """Seconds from the start to the stay of the spot on the target that lasted the fire time (None: none did)."""
+    return next((start / 1000.0 for start, length in runs if length >= fire_ms), None)
 
 
 @dataclass(frozen=True)
@@ -34,7 +62,7 @@ class FlightResult:
     scenario: str
     seed: int
     detector: str
-    success: bool  # reached the target and lit it
+    success: bool  # strict: see ``failures``
     lit_on_target_ms: int
     lit_elsewhere_ms: int
     non_target_hits: int  # the laser came onto something that is not the target
@@ -65,16 +93,22 @@ class FlightResult:
     non_target_what: tuple[str, ...] = ()
     lit_during_fault_ms: int = 0  # laser on while the camera was faulty (a fault injected with ``fault``)
     landed_because: str = ""  # the reason of the controller's move to LAND
+    longest_on_target_ms: int = 0  # the longest unbroken stay of the laser spot on the target
+    fire_ms: int = 0  # the configured fire time the stay must last
+    time_to_target_s: float | None = None  # from the start to the stay that lasted the fire time
+    failures: tuple[str, ...] = ()  # why it failed (empty: success)
 
     def summary(self) -> str:
-        verdict = "reached and lit" if self.success else "FAILED"
+        verdict = "SUCCESS" if self.success else "FAILED"
+        to_target = "-" if self.time_to_target_s is None else f"{self.time_to_target_s:4.1f} s"
         return (
-            f"{self.scenario:10s} seed {self.seed:3d} {self.detector:5s} {verdict:15s} "
-            f"lit {self.lit_on_target_ms:5d} ms "
+            f"{self.scenario:10s} seed {self.seed:3d} {self.detector:5s} {verdict:7s} "
+            f"on target {self.longest_on_target_ms:5d}/{self.fire_ms} ms unbroken, time to target {to_target} "
             f"min dist {self.min_distance:4.2f} m walls {self.wall_hits} crashes {self.crashes} "
             f"non-target {self.non_target_hits} "
             f"sim {self.sim_seconds:5.1f} s wall {self.wall_seconds:5.2f} s ({self.reason})"
             + ("" if self.confirmed in self.reason else f"; drone confirmed {self.confirmed}")
+            + ("" if self.success else f" -- failed: {'; '.join(self.failures)}")
         )
 
 
@@ -195,12 +229,18 @@ def fly(
                         }
                     }
                 )
-            success = score.lit_on_target_ms >= SUCCESS_LIT_MS and score.reached
+            error = None if result.error is None else f"{type(result.error).__name__}: {result.error}"
+            fire_ms = cfg.controller.fire_ms
+            failed = failures(
+                fire_ms=fire_ms, longest_on_target_ms=score.longest_on_target_ms, fired=result.fired,
+                non_target_hits=score.non_target_hits, what=score.non_target_what, wall_hits=state.wall_hits,
+                crashes=state.crashes, landed_disarmed=not (state.armed or world.outputs.armed),
+                laser_off=not world.outputs.laser, error=error)
             return FlightResult(
                 scenario=scenario_name,
                 seed=seed,
                 detector=cfg.detector,
-                success=success,
+                success=not failed,
                 lit_on_target_ms=score.lit_on_target_ms,
                 lit_elsewhere_ms=score.lit_elsewhere_ms,
                 non_target_hits=score.non_target_hits,
@@ -230,7 +270,11 @@ def fly(
                 non_target_what=tuple(score.non_target_what),
                 lit_during_fault_ms=score.lit_during_fault_ms,
                 landed_because=next((t.reason for t in controller.transitions if t.new is State.LAND), ""),
-                error=None if result.error is None else f"{type(result.error).__name__}: {result.error}",
+                error=error,
+                longest_on_target_ms=score.longest_on_target_ms,
+                fire_ms=fire_ms,
+                time_to_target_s=time_to_target(score.on_target_runs, fire_ms),
+                failures=failed,
             )
     finally:
         if recorder is not None:

@@ -94,8 +94,12 @@ class ControllerConfig:
     # the flight controller holds altitude, not position: the pilot brakes from the closing speed it measures
     brake_mps2: float = 0.5  # deceleration the approach plans with (a 5° lean gives about 0.9 m/s²)
     approach_speed_mps: float = 0.6  # top closing speed
-    pitch_accel_mps2: float = 0.8  # what one speed step of pitch does (a 5° lean), for dead reckoning
-    climb_mps_per_step: float = 0.47  # AltHold's climb rate for one speed step of throttle, for the height estimate
+    # one control step of each stick, as the flight controller answers it (pilot/control/pulses.py turns it into a
+    # pulse from the spec's channels and the flight controller's parameters): the tuning is in these units
+    unit_lean_deg: float = 5.0  # the lean one step of pitch (or roll) asks for
+    turn_rate_dps: float = 34.6  # the yaw rate one step of yaw asks for
+    climb_mps_per_step: float = 0.47  # AltHold's climb rate for one step of throttle, also for the height estimate
+    pitch_accel_mps2: float = 0.8  # what one step of pitch does (its lean, less drag), for dead reckoning
 
 
 @dataclass(frozen=True)
@@ -202,6 +206,8 @@ RANGES: dict[str, tuple[float, float]] = {
     "controller.approach_speed_mps": (0.05, 3.0),
     "controller.pitch_accel_mps2": (0.05, 10.0),
     "controller.climb_mps_per_step": (0.01, 5.0),
+    "controller.unit_lean_deg": (0.5, 30.0),
+    "controller.turn_rate_dps": (1.0, 180.0),
     "link.rate_hz": (1.0, 50.0),
     "link.keepalive_fraction": (0.01, 0.99),
     "link.ready_timeout_s": (0.1, 60.0),

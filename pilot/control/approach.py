@@ -55,7 +55,7 @@ def allowed_speed(remaining_m: float, brake_mps2: float, top_mps: float) -> floa
 
 class Momentum:
     """Dead reckoning of the forward speed from the pitch commands the pilot sent, for when vision has none (the
-    target lost while closing in): a pitch command of one speed step accelerates at ``accel_per_step``, and
+    target lost while closing in): a pitch command of one control step accelerates at ``accel_per_step``, and
     with the stick released the speed decays with drag over ``decay_s``. Any vision estimate replaces it."""
 
     def __init__(self, accel_per_step: float, decay_s: float = 3.0) -> None:
@@ -71,7 +71,7 @@ class Momentum:
             self.speed = closing
 
     def advance(self, pitch_steps: float, dt: float) -> None:
-        """``pitch_steps``: the pitch stick held during ``dt``, in speed steps (forward positive)."""
+        """``pitch_steps``: the pitch stick held during ``dt``, in control steps (forward positive)."""
         self.speed += self.accel_per_step * pitch_steps * dt - self.speed * dt / self.decay_s
 
 

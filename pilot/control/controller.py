@@ -39,7 +39,7 @@ States (``State``)::
   frames FIRE switches the laser on (not while the detector sees something else at the aim point: a thing in
   front of the target hides its middle while the circle through its rim stays centred). The laser stays on only
   while the target is found, centred, in range and clear at the aim point;
-  after ``fire_ms`` lit (as the drone confirmed it) it is switched off and the drone lands. While
+  after ``fire_ms`` lit without a break (as the drone confirmed it) it is switched off and the drone lands. While
   firing, small errors (within twice the aim tolerance) are still corrected
   with the servos; larger ones switch the laser off and go back to AIM.
 * Losing the target (``lost_frames`` misses in a row) in ACQUIRE/TRACK/AIM/FIRE: laser off, sticks
@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 import drone_protocol as dp
 
@@ -62,7 +62,7 @@ from ..common.config import ControllerConfig
 from ..vision.detection import Detection
 from ..vision.gating import Gate
 from .approach import ClosingSpeed, Lean, Momentum, allowed_speed
-from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, speed_for, turn_towards
+from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, turn_towards
 from .response import TurnResponse, turn_sense
 from .sticks import HeldSticks
 from .vertical import Height, SeenFrom
@@ -71,19 +71,20 @@ __all__ = ["FLYING", "LOCKED", "Controller", "State", "Transition"]
 
 HOLD_MPS = 0.12  # closing speeds within this are left alone near the target (the estimate's noise)
 VIEW_EDGE = 0.9  # a brake's lean keeps the target's lower edge above this share of the frame's lower half
-MIN_BRAKE = 0.4  # speed steps: the gentlest brake, whatever the view allows
+MIN_BRAKE = 0.4  # control steps: the gentlest brake, whatever the view allows
 RETURN_TOL_M = 0.05  # a search's return to the height the target was seen from ends this close to it
 RETURN_MAX_MS = 3000  # ... or this long after the search began
 
 
 def _brake_steps(speed: float) -> float:
-    """The pitch-back stick, in speed steps, against a closing speed: harder the faster it closes, up to 1.4."""
+    """The pitch-back stick, in control steps, against a closing speed: harder the faster it closes, up to 1.4."""
     return min(1.4, 0.8 + speed)
 
 
 class Controller(ControllerCore):
-    def __init__(self, config: ControllerConfig | None = None, clock: Callable[[], float] = time.monotonic) -> None:
-        super().__init__(config, clock)
+    def __init__(self, config: ControllerConfig | None = None, clock: Callable[[], float] = time.monotonic,
+                 parameters: Mapping[str, float] = dp.FLIGHT_CONTROLLER_PARAMETERS) -> None:
+        super().__init__(config, clock, parameters)
         self.gate = Gate(self.cfg)  # vision gate (issue 12): every sighting and every laser-on goes through it
         self.closing = ClosingSpeed()
         # the same over 1.2 s, for the speed at a loss: a target going out of sight (covered, clipped by the
@@ -97,7 +98,7 @@ class Controller(ControllerCore):
         self.height = Height(self.cfg.climb_mps_per_step)
         self.seen_from = SeenFrom()
         self._return_m: float | None = None  # a search first goes back to this height
-        self.sticks = HeldSticks()
+        self.sticks = HeldSticks(self.pulses)
         self.response = TurnResponse()
         self._turned = 0  # the last frame's hard turn (+1 right, -1 left), whose effect this frame shows
         self._last_ms = self._now()
@@ -112,7 +113,7 @@ class Controller(ControllerCore):
             return None
         if closing > 0.0:
             return self._brake(closing, det)
-        return self._emit(dp.move_forward(speed_for(dp.CommandName.MOVE_FORWARD, min(1.2, 0.6 - closing))))
+        return self._emit(dp.move_forward(self._speed(dp.CommandName.MOVE_FORWARD, min(1.2, 0.6 - closing))))
 
     def _brake(self, speed: float, det: Detection | None = None) -> bytes:
         """Pitch back against a closing speed (``_brake_steps``), with the target in view no harder than keeps it in
@@ -120,10 +121,10 @@ class Controller(ControllerCore):
         frac = _brake_steps(speed)
         if det is not None and det.found:
             frac = max(MIN_BRAKE, min(frac, self._brake_room(det)))
-        return self._emit(dp.move_backward(speed_for(dp.CommandName.MOVE_BACKWARD, frac)))
+        return self._emit(dp.move_backward(self._speed(dp.CommandName.MOVE_BACKWARD, frac)))
 
     def _brake_room(self, det: Detection) -> float:
-        """The backward lean, in speed steps, that keeps the target's lower edge within ``VIEW_EDGE`` of the
+        """The backward lean, in control steps, that keeps the target's lower edge within ``VIEW_EDGE`` of the
         frame: the target moves down the frame by the change from the present lean."""
         tan_v = self._tan_v(det)
         edge = det.error_y + (det.size / det.height if det.height else 0.0)
@@ -158,7 +159,7 @@ class Controller(ControllerCore):
         if det is not None and self.gate.acquired() and not det.predicted:
             self.seen_from.saw(self.height.m)
         self.sticks.sent(frame, self._now())
-        self._turned = turn_sense(frame)
+        self._turned = turn_sense(frame, self.pulses)
         return frame
 
     def _decide_frame(self, det: Detection | None) -> bytes | None:
@@ -196,8 +197,8 @@ class Controller(ControllerCore):
         if step is not None:
             return self._emit(step)
         if self._search_sign > 0:
-            return self._emit(dp.turn_right(speed_for(dp.CommandName.TURN_RIGHT, 1.0)))
-        return self._emit(dp.turn_left(speed_for(dp.CommandName.TURN_LEFT, 1.0)))
+            return self._emit(dp.turn_right(self._speed(dp.CommandName.TURN_RIGHT, 1.0)))
+        return self._emit(dp.turn_left(self._speed(dp.CommandName.TURN_LEFT, 1.0)))
 
     def _go(self, new: State, reason: str) -> None:
         if new is State.SEARCH and self.state is not State.SEARCH:
@@ -214,8 +215,8 @@ class Controller(ControllerCore):
             self._return_m = None
             return None
         if off > 0.0:
-            return dp.move_up(speed_for(dp.CommandName.MOVE_UP, 1.0))
-        return dp.move_down(speed_for(dp.CommandName.MOVE_DOWN, 1.0))
+            return dp.move_up(self._speed(dp.CommandName.MOVE_UP, 1.0))
+        return dp.move_down(self._speed(dp.CommandName.MOVE_DOWN, 1.0))
 
     def _search_step(self, elapsed_ms: int) -> bytes | None:
         """The height change due this far into the sweep (None: turn): after each leg one step down, then two
@@ -227,8 +228,8 @@ class Controller(ControllerCore):
             moving = step if k == 0 else 2 * step
             if t < moving:
                 if k % 2 == 0:
-                    return dp.move_down(speed_for(dp.CommandName.MOVE_DOWN, 1.0))
-                return dp.move_up(speed_for(dp.CommandName.MOVE_UP, 1.0))
+                    return dp.move_down(self._speed(dp.CommandName.MOVE_DOWN, 1.0))
+                return dp.move_up(self._speed(dp.CommandName.MOVE_UP, 1.0))
             t -= moving
             k += 1
         return None
@@ -309,16 +310,16 @@ class Controller(ControllerCore):
             if closing > allowed + 0.15:  # braking comes before any other correction
                 return self._brake(closing - allowed, det)
         if abs(ex) > cfg.dead_band_x:
-            return self._emit(turn_towards(ex))
+            return self._emit(turn_towards(ex, self.pulses))
         if abs(ey) > cfg.dead_band_y and not self.seen_from.barred(ey < 0, self.height.settles_m, ey):
             frac = 0.5 + 0.5 * min(1.0, abs(ey) / 0.6)
             if ey < 0:
-                return self._emit(dp.move_up(speed_for(dp.CommandName.MOVE_UP, frac)))
-            return self._emit(dp.move_down(speed_for(dp.CommandName.MOVE_DOWN, frac)))
+                return self._emit(dp.move_up(self._speed(dp.CommandName.MOVE_UP, frac)))
+            return self._emit(dp.move_down(self._speed(dp.CommandName.MOVE_DOWN, frac)))
         if closing > allowed - 0.1:
             return self._emit(dp.hold_altitude())  # coasting at about the right speed
         frac = 1.8 if size < 0.45 * cfg.approach_size else (1.0 if size < 0.75 * cfg.approach_size else 0.6)
-        self._coast = self._emit(dp.move_forward(speed_for(dp.CommandName.MOVE_FORWARD, frac)))
+        self._coast = self._emit(dp.move_forward(self._speed(dp.CommandName.MOVE_FORWARD, frac)))
         return self._coast
 
     def _on_aim(self, det: Detection | None) -> bytes | None:
@@ -372,6 +373,7 @@ class Controller(ControllerCore):
         if det is None or not self._found(det):
             self._misses += 1
             off = self._laser(False)  # never lit without a lock
+            self.lit_ms = 0  # the fire time is one unbroken stay on the target: it starts again
             if self._misses >= self.cfg.lost_frames:
                 self._go(State.SEARCH, "target lost while firing")
             return off if off is not None else self._emit(dp.hold_altitude())
@@ -387,6 +389,7 @@ class Controller(ControllerCore):
             return off if off is not None else self._on_aim(det)
         if not self.gate.confirmed():  # vision gate: found, but not confirmed in enough frames in a row
             off = self._laser(False)
+            self.lit_ms = 0
             return off if off is not None else self._emit(dp.hold_altitude())
         on = self._laser(True)
         if on is not None:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import enum
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import drone_protocol as dp
@@ -17,6 +17,7 @@ import drone_protocol as dp
 from ..common.config import ControllerConfig
 from ..link.drone_view import DroneView
 from ..vision.detection import Detection
+from .pulses import StickModel
 
 
 class State(enum.Enum):
@@ -46,23 +47,24 @@ class Transition:
     reason: str
 
 
-def speed_for(command: dp.CommandName, fraction: float) -> int:
-    """A speed for ``command`` at ``fraction`` (0..2) of the spec's speed step beyond its channel median,
-    in the command's own sense and clamped to its allowed range."""
+def speed_for(command: dp.CommandName, fraction: float, pulses: StickModel) -> int:
+    """A speed for ``command`` at ``fraction`` (0..2) of a control step beyond its channel median (the pulse offset
+    ``pulses`` derives from the spec), in the command's own sense and clamped to its allowed range."""
     spec = dp.COMMANDS[command]
-    median = dp.CHANNELS[dp.ChannelName(spec.target)].median
+    channel = dp.ChannelName(spec.target)
+    median = dp.CHANNELS[channel].median
     default = spec.default if spec.default is not None else median
     sense = 1 if default >= median else -1
-    value = median + sense * round(dp.SPEED_STEP_US * max(0.0, fraction))
+    value = median + sense * round(pulses.unit_us(channel, sense > 0) * max(0.0, fraction))
     return max(spec.minimum, min(spec.maximum, value))
 
 
-def turn_towards(error_x: float) -> bytes:
+def turn_towards(error_x: float, pulses: StickModel) -> bytes:
     """A turn towards a horizontal error (-1 .. +1 of the half-width): gentle near the middle, full from half-way."""
     frac = 0.35 + 0.65 * min(1.0, abs(error_x) / 0.5)
     if error_x > 0:
-        return dp.turn_right(speed_for(dp.CommandName.TURN_RIGHT, frac))
-    return dp.turn_left(speed_for(dp.CommandName.TURN_LEFT, frac))
+        return dp.turn_right(speed_for(dp.CommandName.TURN_RIGHT, frac, pulses))
+    return dp.turn_left(speed_for(dp.CommandName.TURN_LEFT, frac, pulses))
 
 
 class ControllerCore:
@@ -70,8 +72,10 @@ class ControllerCore:
         self,
         config: ControllerConfig | None = None,
         clock: Callable[[], float] = time.monotonic,
+        parameters: Mapping[str, float] = dp.FLIGHT_CONTROLLER_PARAMETERS,
     ) -> None:
         self.cfg = config or ControllerConfig()
+        self.pulses = StickModel(self.cfg, parameters)  # a control step's pulse on each stick, from the spec
         self._clock = clock
         self.state = State.IDLE
         self.transitions: list[Transition] = []
@@ -120,6 +124,9 @@ class ControllerCore:
         self._misses = 0
         self._coast = None
         self._centred = 0
+
+    def _speed(self, command: dp.CommandName, fraction: float) -> int:
+        return speed_for(command, fraction, self.pulses)
 
     def _emit(self, frame: bytes) -> bytes:
         self.last_command = frame
@@ -259,7 +266,7 @@ class ControllerCore:
         leave it within ``RESET_ERROR`` of the frame's middle (None: reset now)."""
         bearing = max(-80.0, min(80.0, self._bearing(det)))  # (the servo's own limit is nearer; past 90° tan turns)
         after = math.tan(math.radians(bearing)) / self._tan_h  # the horizontal error a reset would leave
-        return None if abs(after) <= RESET_ERROR else turn_towards(after)
+        return None if abs(after) <= RESET_ERROR else turn_towards(after, self.pulses)
 
     def _on_idle(self, det: Detection | None) -> bytes | None:
         return None
@@ -302,7 +309,7 @@ class ControllerCore:
         if self._elapsed() >= self.cfg.takeoff_ms:
             self._go(State.HOLD, "take-off climb done")
             return self._on_hold(det)
-        return self._emit(dp.move_up(speed_for(dp.CommandName.MOVE_UP, 1.0)))
+        return self._emit(dp.move_up(self._speed(dp.CommandName.MOVE_UP, 1.0)))
 
     def _on_hold(self, det: Detection | None) -> bytes | None:
         if self._elapsed() >= self.cfg.settle_ms:

@@ -9,15 +9,16 @@ from dataclasses import dataclass
 
 import drone_protocol as dp
 
+from .pulses import StickModel
 from .sticks import deflection_steps
 
-STRONG_STEPS = 0.7  # only turns at least this hard count (speed steps): about 20°/s past the yaw dead zone
+STRONG_STEPS = 0.7  # only turns at least this hard count (control steps): about 20°/s past the yaw dead zone
 NO_RESPONSE_MS = 3000  # turning hard this long moves a still target across the whole frame
 STILL_SHARE = 0.05  # ... while the target moved less than this share of the frame's width: the turn did nothing
 _TURNS = {dp.CommandName.TURN_RIGHT: 1, dp.CommandName.TURN_LEFT: -1}
 
 
-def turn_sense(frame: bytes | None) -> int:
+def turn_sense(frame: bytes | None, pulses: StickModel) -> int:
     """+1 for a hard turn right, -1 for a hard turn left, 0 for any other frame."""
     if frame is None:
         return 0
@@ -26,7 +27,7 @@ def turn_sense(frame: bytes | None) -> int:
     except dp.ProtocolError:
         return 0
     sense = _TURNS.get(command.name, 0)
-    if sense and deflection_steps(command, dp.ChannelName.YAW) >= STRONG_STEPS:
+    if sense and deflection_steps(command, dp.ChannelName.YAW, pulses) >= STRONG_STEPS:
         return sense
     return 0
 

@@ -6,19 +6,22 @@ from __future__ import annotations
 
 import drone_protocol as dp
 
+from .pulses import StickModel
+
 STICK_CHANNELS = frozenset(c.value for c in dp.ChannelName)  # commands that move a stick
 
 
-def deflection_steps(command: dp.Command, channel: dp.ChannelName) -> float:
-    """A stick command's deflection from its channel's median, in speed steps."""
+def deflection_steps(command: dp.Command, channel: dp.ChannelName, pulses: StickModel) -> float:
+    """A stick command's deflection from its channel's median, in control steps."""
     median = dp.CHANNELS[channel].median
-    return abs(int(command.value or median) - median) / dp.SPEED_STEP_US
+    return abs(pulses.steps(channel, int(command.value or median) - median))
 
 
 class HeldSticks:
-    def __init__(self) -> None:
-        self._pitch = 0.0  # speed steps, forward positive
-        self._throttle = 0.0  # speed steps, up positive
+    def __init__(self, pulses: StickModel) -> None:
+        self._pulses = pulses
+        self._pitch = 0.0  # control steps, forward positive
+        self._throttle = 0.0  # control steps, up positive
         self._until_ms = 0
 
     def pitch(self, now_ms: int) -> float:
@@ -41,7 +44,7 @@ class HeldSticks:
         self._until_ms = now_ms + dp.COMMAND_TIMEOUT_MS
         if channel == dp.ChannelName.PITCH.value:
             sense = 1 if command.name is dp.CommandName.MOVE_FORWARD else -1
-            self._pitch = sense * deflection_steps(command, dp.ChannelName.PITCH)
+            self._pitch = sense * deflection_steps(command, dp.ChannelName.PITCH, self._pulses)
         elif channel == dp.ChannelName.THROTTLE.value:
             sense = 1 if command.name is dp.CommandName.MOVE_UP else -1
-            self._throttle = sense * deflection_steps(command, dp.ChannelName.THROTTLE)
+            self._throttle = sense * deflection_steps(command, dp.ChannelName.THROTTLE, self._pulses)

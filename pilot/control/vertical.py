@@ -2,7 +2,7 @@
 below, and the other way round.
 
 The pilot has no altimeter. In AltHold the throttle stick sets a climb rate, so ``Height`` integrates the pilot's
-own throttle commands (``climb_mps_per_step`` a speed step, reached with a lag): an estimate that drifts over a
+own throttle commands (``climb_mps_per_step`` a control step, reached with a lag): an estimate that drifts over a
 flight but holds over the few seconds between a sighting and its loss, which is all ``SeenFrom`` compares.
 
 ``SeenFrom`` remembers the height of the last measured sighting. A target lost after the drone climbed above that
@@ -31,7 +31,7 @@ class Height:
         self.rate = 0.0  # m/s
 
     def advance(self, throttle_steps: float, dt: float) -> None:
-        """``throttle_steps``: the throttle stick held during ``dt``, in speed steps (up positive)."""
+        """``throttle_steps``: the throttle stick held during ``dt``, in control steps (up positive)."""
         if dt <= 0.0:
             return
         target = self.climb_mps_per_step * throttle_steps

@@ -48,6 +48,21 @@ class FlightScore:
     render_ms: float = 0.0  # MuJoCo's renderer (and posing the past for it)
     sensor_ms: float = 0.0  # the sensor's effects
     frames: int = 0
+    # each stay of the laser spot on the target, unbroken (lit, on its surface, within reach): [start ms, length ms]
+    on_target_runs: list[list[int]] = field(default_factory=list)
+    on_target_now: bool = False
+
+    def spot(self, on_target: bool, t_ms: int, dt_ms: int) -> None:
+        """The spot during the ``dt_ms`` that end at ``t_ms``: a stay on the target goes on or ends."""
+        if on_target and not self.on_target_now:
+            self.on_target_runs.append([t_ms - dt_ms, 0])
+        if on_target:
+            self.on_target_runs[-1][1] += dt_ms
+        self.on_target_now = on_target
+
+    @property
+    def longest_on_target_ms(self) -> int:
+        return max((length for _, length in self.on_target_runs), default=0)
 
 
 class PortCounts(Protocol):
@@ -229,6 +244,7 @@ class SimWorld(Closing):
         score.max_altitude = max(score.max_altitude, s.z)
         if not outputs.laser:
             self._last_hit = -1
+            score.spot(False, self._t_ms, dt_ms)
             return
         fault = self.fault
         if fault is not None and self.fault_start is None:
@@ -236,6 +252,7 @@ class SimWorld(Closing):
         if fault is not None and fault.active(self._t_ms / 1000.0, self.fault_start):
             score.lit_during_fault_ms += dt_ms
         hit = self.laser_hit()
+        score.spot(hit == self._aim_geom and dist <= self.reach_m, self._t_ms, dt_ms)
         if hit == self._aim_geom and dist <= self.reach_m:
             score.lit_on_target_ms += dt_ms
         else:

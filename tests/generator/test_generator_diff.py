@@ -16,6 +16,7 @@ CODE_R = ("  out_of_range:\n    code: r\n", "  out_of_range:\n    code: R\n")
 TURN_LEFT = "      l:\n        name: left\n        description: Turn left"
 TURN_RIGHT = "      r:\n        name: right\n        description: Turn right"
 ANGLE = "    range: [1, 180]"
+RELOAD = "re-load generated/ardupilot/drone.parm into the flight controller"
 
 # (id, edits of the fixture, expected lines of the report without the summary, breaking?)
 PAIRS = [
@@ -56,6 +57,19 @@ PAIRS = [
      ["BREAK frame.integrity: 'none' -> 'crc8'", "BREAK frame.wire_length: 6 -> 8"], True),
     ("inter-byte timeout lowered", (("  inter_byte_timeout_ms: 20", "  inter_byte_timeout_ms: 10"),),
      ["BREAK frame.inter_byte_timeout_ms: 20 -> 10"], True),
+    # how the drone flies: a new dead band or reversal needs the flight controller's parameters loaded again
+    ("throttle dead band widened", (("  throttle_dead_band: 10", "  throttle_dead_band: 100"),),
+     [f"BREAK flight_controller.THR_DZ: 10 -> 100 ({RELOAD})"], True),
+    ("pitch reversal removed", (("  reversed: [pitch]", "  reversed: []"),),
+     [f"BREAK flight_controller.RC2_REVERSED: 1 -> unset (ArduCopter's default) ({RELOAD})"], True),
+    ("yaw reversed too", (("  reversed: [pitch]", "  reversed: [pitch, yaw]"),),
+     [f"BREAK flight_controller.RC4_REVERSED: unset -> 1 ({RELOAD})"], True),
+    ("speed step changed", (("  step_us: 100", "  step_us: 150"),),
+     ["ok    flight.step_us: 100 -> 150 (how the drone flies: the default speeds and the landing descent)",
+      *(f"ok    command {code} ({name}): default {old} -> {new}" for code, name, old, new in (
+          ("mf", "move_forward", 1600, 1650), ("mb", "move_backward", 1400, 1350), ("ml", "move_left", 1400, 1350),
+          ("mr", "move_right", 1600, 1650), ("mu", "move_up", 1621, 1671), ("md", "move_down", 1421, 1371),
+          ("tl", "turn_left", 1424, 1374), ("tr", "turn_right", 1624, 1674)))], False),
 ]
 
 

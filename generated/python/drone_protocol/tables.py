@@ -54,6 +54,32 @@ LANDING_MS: Final = 8000
 MODE_STABILIZE_US: Final = 1165
 MODE_ALT_HOLD_US: Final = 1425
 SPEED_STEP_US: Final = 100
+#: The flight controller's parameters the spec sets (generated/ardupilot/drone.parm): how ArduCopter reads the sticks.
+FLIGHT_CONTROLLER_PARAMETERS: Final[Mapping[str, int]] = MappingProxyType({
+    "RCMAP_ROLL": 1,
+    "RCMAP_PITCH": 2,
+    "RCMAP_THROTTLE": 3,
+    "RCMAP_YAW": 4,
+    "RC1_MIN": 1000,
+    "RC1_MAX": 2000,
+    "RC1_TRIM": 1500,
+    "RC2_MIN": 1000,
+    "RC2_MAX": 2000,
+    "RC2_TRIM": 1500,
+    "RC2_REVERSED": 1,
+    "RC3_MIN": 1029,
+    "RC3_MAX": 2012,
+    "RC3_TRIM": 1521,
+    "RC4_MIN": 1035,
+    "RC4_MAX": 2012,
+    "RC4_TRIM": 1524,
+    "FS_THR_ENABLE": 3,
+    "FS_THR_VALUE": 989,
+    "THR_DZ": 10,
+    "FLTMODE_CH": 5,
+    "FLTMODE1": 0,
+    "FLTMODE3": 2,
+})
 
 
 class ChannelName(_TextEnum):

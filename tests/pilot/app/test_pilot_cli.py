@@ -30,7 +30,7 @@ def test_sim_flight_with_record(virtual_drone: Path, tmp_path: Path) -> None:
         "--virtual-drone", str(virtual_drone), "--scenario", "side", "--seed", "5", "--record", str(rec), "--no-status"
     )
     assert code == 0, out + err
-    assert "reached and lit" in out
+    assert "SUCCESS" in out
     assert f"recording: {rec / 'flight.avi'}" in out and f"path:      {rec / 'path.png'}" in out
     assert (rec / "flight.avi").stat().st_size > 0 and (rec / "path.png").stat().st_size > 0
     commands = [json.loads(line).get("command") for line in (rec / "log.jsonl").read_text().splitlines()]
@@ -123,7 +123,7 @@ def test_python_dash_m_pilot(virtual_drone: Path) -> None:
         timeout=120,
     )
     assert proc.returncode == 0, proc.stdout + proc.stderr
-    assert "reached and lit" in proc.stdout
+    assert "SUCCESS" in proc.stdout
 
 
 def test_help_lists_the_options() -> None:

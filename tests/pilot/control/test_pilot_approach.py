@@ -12,6 +12,7 @@ from controller_rig import CFG, MISS, Rig, name, seen, st, to_state
 
 from pilot.control.approach import ClosingSpeed, Lean, allowed_speed
 from pilot.control.controller import MIN_BRAKE, Controller, State
+from pilot.control.pulses import StickModel
 from pilot.vision.detection import range_of
 
 W = 320
@@ -165,4 +166,4 @@ def test_a_brake_keeps_a_low_target_in_the_frame() -> None:
     median = dp.CHANNELS[dp.ChannelName.PITCH].median
     centred, low = median - brake_us(0.0), median - brake_us(0.5)
     assert 0 < low < centred
-    assert low >= round(MIN_BRAKE * dp.SPEED_STEP_US)
+    assert low >= round(MIN_BRAKE * StickModel().unit_us(dp.ChannelName.PITCH, False))

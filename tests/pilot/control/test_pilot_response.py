@@ -11,16 +11,21 @@ from controller_rig import CFG, name, seen, st, to_state
 
 from pilot.control.controller import State
 from pilot.control.controller_core import RESET_ERROR
+from pilot.control.pulses import StickModel
 from pilot.control.response import NO_RESPONSE_MS, TurnResponse, turn_sense
+
+PULSES = StickModel()
+YAW = dp.ChannelName.YAW
 
 
 def test_only_hard_turns_count() -> None:
-    assert turn_sense(dp.turn_right(dp.CHANNELS[dp.ChannelName.YAW].median + dp.SPEED_STEP_US)) == 1
-    assert turn_sense(dp.turn_left(dp.CHANNELS[dp.ChannelName.YAW].median - dp.SPEED_STEP_US)) == -1
-    assert turn_sense(dp.turn_right(dp.CHANNELS[dp.ChannelName.YAW].median + dp.SPEED_STEP_US // 4)) == 0
-    assert turn_sense(dp.hold_altitude()) == 0
-    assert turn_sense(None) == 0
-    assert turn_sense(b"garbage") == 0
+    median = dp.CHANNELS[YAW].median
+    assert turn_sense(dp.turn_right(median + round(PULSES.unit_us(YAW, True))), PULSES) == 1
+    assert turn_sense(dp.turn_left(median - round(PULSES.unit_us(YAW, False))), PULSES) == -1
+    assert turn_sense(dp.turn_right(median + round(PULSES.unit_us(YAW, True) / 4)), PULSES) == 0
+    assert turn_sense(dp.hold_altitude(), PULSES) == 0
+    assert turn_sense(None, PULSES) == 0
+    assert turn_sense(b"garbage", PULSES) == 0
 
 
 def test_a_target_that_moves_or_a_pause_in_turning_restarts_the_count() -> None:
