@@ -89,10 +89,11 @@ def _environment(target: Target) -> jinja2.Environment:
 def render_all(spec: Spec) -> dict[str, bytes]:
     """Every generated file, keyed by its path relative to the output folder."""
     names = {"{package}": spec.name, "{Library}": pascal(spec.name)}
+    parameter_files = ardupilot.parameter_files(spec)
     context = {
         "spec": spec,
         "vectors": build_vectors(spec),
-        "ardupilot": ardupilot.parameters(spec),
+        "parameter_files": parameter_files,
         "header": header_lines(spec),
         "header_json": json.dumps(
             {"notice": header_lines(spec)[0], "fingerprint": spec.fingerprint, "spec": spec.source_name,
@@ -114,12 +115,16 @@ def render_all(spec: Spec) -> dict[str, bytes]:
             rel = template_path.relative_to(root).as_posix()
             if template_path.name.startswith("_") and not template_path.name.startswith("__"):
                 continue  # a partial (_name, not __init__), included by another template of the folder
-            text = env.get_template(rel).render(context)
             out = rel[: -len(".j2")]
             for placeholder, value in names.items():
                 out = out.replace(placeholder, value)
-            path = f"{target.out_dir}/{out}" if target.out_dir else out
-            files[path] = (text if target.own_header else _with_header(path, text, spec)).encode("utf-8")
+            # a "{line}" template is written once per ArduCopter line the spec lists, into that line's folder
+            renders = ([(out.replace("{line}", fw.line.folder), {"fw": fw}) for fw in parameter_files]
+                       if "{line}" in out else [(out, {})])
+            for out_path, extra in renders:
+                text = env.get_template(rel).render(context | extra)
+                path = f"{target.out_dir}/{out_path}" if target.out_dir else out_path
+                files[path] = (text if target.own_header else _with_header(path, text, spec)).encode("utf-8")
     return files
 
 
