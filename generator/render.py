@@ -11,7 +11,7 @@ from pathlib import Path
 
 import jinja2
 
-from . import ardupilot, filters
+from . import ardupilot, bench, filters
 from .build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
 from .diff import contract
 from .model import Spec
@@ -110,6 +110,9 @@ def render_all(spec: Spec) -> dict[str, bytes]:
     files: dict[str, bytes] = {}
     for target in TARGETS:
         env = _environment(target)
+        if target.name == "docs":  # the bench table reads the constants of the C++ header rendered before it
+            library = pascal(spec.name)
+            context["bench"] = bench.table(spec, files[f"arduino/{library}/src/{library}_spec.h"].decode("utf-8"))
         root = TEMPLATES / target.name
         for template_path in sorted(root.rglob("*.j2")):
             rel = template_path.relative_to(root).as_posix()
