@@ -11,7 +11,7 @@ from pathlib import Path
 
 import jinja2
 
-from . import ardupilot, bench, filters
+from . import ardupilot, bench, diagram, filters
 from .build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
 from .diff import contract
 from .model import Spec
@@ -94,6 +94,8 @@ def render_all(spec: Spec) -> dict[str, bytes]:
         "spec": spec,
         "vectors": build_vectors(spec),
         "parameter_files": parameter_files,
+        "wiring_rows": diagram.wires(spec),
+        "svg_height": diagram.height(spec),
         "header": header_lines(spec),
         "header_json": json.dumps(
             {"notice": header_lines(spec)[0], "fingerprint": spec.fingerprint, "spec": spec.source_name,

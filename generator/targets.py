@@ -52,6 +52,7 @@ COMMENT_BY_SUFFIX = {
     ".rs": "//",
     ".md": "<!--",
     ".html": "<!--",
+    ".svg": "<!--",  # XML allows a comment before the root element
     ".json": "json",
     ".lock": "#",  # Cargo.lock
 }

@@ -16,7 +16,7 @@ from generator.targets import comment_style
 # What each format accepts as a comment: the header's first line must start with it.
 OPENERS = {".properties": "# ", ".txt": "# ", ".parm": "# ", ".params": "# ", ".py": "# ", ".typed": "# ", ".h": "// ",
            ".ino": "// ", ".md": "<!--\n", ".c": "// ", ".rs": "// ", ".toml": "# ", ".lock": "# ", ".ts": "// ",
-           ".mjs": "// ", ".html": "<!--"}
+           ".mjs": "// ", ".html": "<!--", ".svg": "<!--\n"}
 
 
 def test_every_generated_file_opens_with_its_own_formats_comment() -> None:
