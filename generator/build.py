@@ -143,7 +143,7 @@ class _Builder(CommandsBuilder):
         status = read_status(top, self.errors)
         settled = self._settled(top)
         project, wiring = hardware.read(top, channels, list(servos), failsafe_throttle, (stabilize, alt_hold))
-        flight_controller = hardware.flight_controller(top, channels, step)
+        flight_controller = hardware.flight_controller(top, channels, wiring, failsafe_throttle, step)
         top.finish()
         if self.errors:
             return None

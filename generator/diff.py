@@ -13,7 +13,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from .ardupilot import parameters
+from .ardupilot import parameter_files
 from .model import Spec
 
 Contract = dict[str, Any]
@@ -48,9 +48,10 @@ def contract(spec: Spec) -> Contract:
                    for st in spec.status.states},
         "texts": {"title": spec.title, "description": spec.description},
         # how the drone flies: the speed step (the firmware's default speeds and its landing descent) and the
-        # parameters the flight controller must be loaded with (generated/ardupilot/drone.parm)
+        # parameters the flight controller must be loaded with (generated/ardupilot/<line>/), per ArduCopter line
         "flight": {"step_us": spec.speed_step_us},
-        "flight_controller": {p.name: p.value for p in parameters(spec)},
+        "flight_controller": {f"{lp.line.folder}/{p.name}": p.value
+                              for lp in parameter_files(spec) for p in lp.params},
     }
 
 
@@ -137,11 +138,12 @@ def _sections(old: Contract, new: Contract, changes: list[Change]) -> None:
 
 def _flight_controller(old: Contract, new: Contract, changes: list[Change]) -> None:
     """Any change to the flight controller's parameters breaks a drone loaded with the old ones: it flies
-    otherwise (a dead band, a reversed stick, a range) until generated/ardupilot/drone.parm is loaded again."""
+    otherwise (a dead band, a reversed stick, a range) until its line's generated/ardupilot/<line>/ file is loaded
+    again. Keys are `<line folder>/<parameter>`."""
     if "flight_controller" not in old or "flight_controller" not in new:
         return  # a contract written before the section existed
     before, after = old["flight_controller"], new["flight_controller"]
-    reload = "re-load generated/ardupilot/drone.parm into the flight controller"
+    reload = "re-load the parameter file in generated/ardupilot/ into the flight controller"
     for name in sorted(set(before) | set(after)):
         a, b = before.get(name), after.get(name)
         if a != b:

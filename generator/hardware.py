@@ -4,6 +4,7 @@ Called from one line of build.py; kept apart so that the ArduPilot-facing rules 
 
 from __future__ import annotations
 
+from . import ardupilot as ap
 from .ardupilot import FS_THR_RANGE_US, STICKS, THR_DZ_DEFAULT, THR_DZ_RANGE, fs_thr_value, mode_slot
 from .errors import SpecError
 from .model import Channel, FlightControllerSetup, Project, WiredPin, Wiring
@@ -24,15 +25,16 @@ def read(top: Reader, channels: dict[str, Channel], servo_names: list[str], fail
     return project, wiring
 
 
-def flight_controller(top: Reader, channels: dict[str, Channel], step_us: int) -> FlightControllerSetup:
-    """The optional `flight_controller` section: ArduCopter's defaults when it is absent."""
+def flight_controller(top: Reader, channels: dict[str, Channel], wiring: Wiring, failsafe_us: int,
+                      step_us: int) -> FlightControllerSetup:
+    """The optional `flight_controller` section: ArduCopter's defaults and every supported line when absent."""
     node = top.child("flight_controller", required=False)
     if node is None:
         step_node = top.node.children["speeds"].children.get("step_us") if top.ok and "speeds" in top.node.children \
             else None
         if step_node is not None:
             _check_dead_band(top, step_node, "speeds.step_us", THR_DZ_DEFAULT, channels, step_us)
-        return FlightControllerSetup((), THR_DZ_DEFAULT)
+        return FlightControllerSetup((), THR_DZ_DEFAULT, _lines(top, None, None, channels, wiring, failsafe_us))
     r = Reader(node, "flight_controller", top.errors)
     names: list[str] = []
     listed = r.child("reversed", required=False)
@@ -57,8 +59,39 @@ def flight_controller(top: Reader, channels: dict[str, Channel], step_us: int) -
     elif is_int(dz_node):
         assert dz_node is not None
         _check_dead_band(r, dz_node, r.sub("throttle_dead_band"), dead_band, channels, step_us)
+    firmware = _lines(top, r, r.child("firmware", required=False), channels, wiring, failsafe_us)
     r.finish()
-    return FlightControllerSetup(tuple(names), dead_band)
+    return FlightControllerSetup(tuple(names), dead_band, firmware)
+
+
+def _lines(top: Reader, r: Reader | None, listed: Node | None, channels: dict[str, Channel], wiring: Wiring,
+           failsafe_us: int) -> tuple[str, ...]:
+    """`flight_controller.firmware`: the ArduCopter lines to write parameter files for, each able to fly the spec
+    (every supported line when the key is absent)."""
+    path = "flight_controller.firmware"
+    items: list[tuple[str, Node | None]] = [(key, None) for key in ap.LINE_KEYS]
+    if listed is not None and r is not None:
+        if not isinstance(listed.value, list) or not listed.items:
+            r.error(listed, f"expected a list of ArduCopter lines, found {listed.value!r}",
+                    "supported: " + ap.supported(), path=path)
+            return ()
+        items = []
+        for item in listed.items:
+            key = str(item.value) if isinstance(item.value, (str, int, float)) and item.value is not True else ""
+            if key not in ap.LINE_KEYS or any(key == seen for seen, _ in items):
+                what = "is listed twice" if key in ap.LINE_KEYS else "is not a supported ArduCopter line"
+                r.error(item, f"{item.value!r} {what}", "supported: " + ap.supported(), path=path)
+            else:
+                items.append((key, item))
+    throttle = channels.get("throttle")
+    if throttle is None or failsafe_us <= 0 or any(e.path.startswith("wiring.") for e in top.errors):
+        return tuple(key for key, _ in items)  # reported where they are wrong
+    for key, at in items:
+        for problem in ap.problems(ap.line(key), wiring.rc_input("mode"), failsafe_us, throttle.recorded_min):
+            where = at if at is not None else top.node.children.get("flight_controller", top.node)
+            top.error(where, f"ArduCopter {key}: {problem}", "remove the line from flight_controller.firmware, or "
+                      "change the spec; supported: " + ap.supported(), path)
+    return tuple(key for key, _ in items)
 
 
 def _check_dead_band(r: Reader, node: Node, path: str, dead_band: int, channels: dict[str, Channel],

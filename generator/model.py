@@ -163,8 +163,9 @@ class Vector:
 class FlightControllerSetup:
     """How the flight controller reads the sticks (spec section `flight_controller`, optional)."""
 
-    reversed: tuple[str, ...]  # channels ArduCopter must reverse (RCn_REVERSED)
+    reversed: tuple[str, ...]  # channels ArduCopter must reverse (RCn_REVERSED, RCn_REV in 3.2)
     throttle_dead_band: int  # THR_DZ, 0-1000 of the throttle range
+    firmware: tuple[str, ...]  # the ArduCopter lines to write parameter files for (ardupilot.LINES keys)
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import jinja2
 
-from . import ardupilot, filters
+from . import ardupilot, bench, diagram, filters
 from .build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
 from .diff import contract
 from .model import Spec
@@ -89,10 +89,15 @@ def _environment(target: Target) -> jinja2.Environment:
 def render_all(spec: Spec) -> dict[str, bytes]:
     """Every generated file, keyed by its path relative to the output folder."""
     names = {"{package}": spec.name, "{Library}": pascal(spec.name)}
+    parameter_files = ardupilot.parameter_files(spec)
     context = {
         "spec": spec,
         "vectors": build_vectors(spec),
-        "ardupilot": ardupilot.parameters(spec),
+        "parameter_files": parameter_files,
+        # the pilot models the sticks with the newest line's parameter names (ArduCopter 4's RCn_REVERSED, THR_DZ)
+        "ardupilot": ardupilot.pilot_parameters(parameter_files),
+        "wiring_rows": diagram.wires(spec),
+        "svg_height": diagram.height(spec),
         "header": header_lines(spec),
         "header_json": json.dumps(
             {"notice": header_lines(spec)[0], "fingerprint": spec.fingerprint, "spec": spec.source_name,
@@ -109,17 +114,24 @@ def render_all(spec: Spec) -> dict[str, bytes]:
     files: dict[str, bytes] = {}
     for target in TARGETS:
         env = _environment(target)
+        if target.name == "docs":  # the bench table reads the constants of the C++ header rendered before it
+            library = pascal(spec.name)
+            context["bench"] = bench.table(spec, files[f"arduino/{library}/src/{library}_spec.h"].decode("utf-8"))
         root = TEMPLATES / target.name
         for template_path in sorted(root.rglob("*.j2")):
             rel = template_path.relative_to(root).as_posix()
             if template_path.name.startswith("_") and not template_path.name.startswith("__"):
                 continue  # a partial (_name, not __init__), included by another template of the folder
-            text = env.get_template(rel).render(context)
             out = rel[: -len(".j2")]
             for placeholder, value in names.items():
                 out = out.replace(placeholder, value)
-            path = f"{target.out_dir}/{out}" if target.out_dir else out
-            files[path] = (text if target.own_header else _with_header(path, text, spec)).encode("utf-8")
+            # a "{line}" template is written once per ArduCopter line the spec lists, into that line's folder
+            renders = ([(out.replace("{line}", fw.line.folder), {"fw": fw}) for fw in parameter_files]
+                       if "{line}" in out else [(out, {})])
+            for out_path, extra in renders:
+                text = env.get_template(rel).render(context | extra)
+                path = f"{target.out_dir}/{out_path}" if target.out_dir else out_path
+                files[path] = (text if target.own_header else _with_header(path, text, spec)).encode("utf-8")
     return files
 
 

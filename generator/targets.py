@@ -40,7 +40,8 @@ COMMENT_BY_SUFFIX = {
     ".properties": "#",  # Arduino's library.properties: '#' is the only comment its parsers accept
     ".py": "#",
     ".toml": "#",
-    ".parm": "#",  # ArduPilot parameter files (Mission Planner, QGroundControl, MAVProxy)
+    ".parm": "#",  # ArduPilot parameter files (Mission Planner, MAVProxy)
+    ".params": "#",  # QGroundControl's parameter files: it skips lines that start with '#'
     ".h": "//",
     ".hpp": "//",
     ".c": "//",
@@ -51,6 +52,7 @@ COMMENT_BY_SUFFIX = {
     ".rs": "//",
     ".md": "<!--",
     ".html": "<!--",
+    ".svg": "<!--",  # XML allows a comment before the root element
     ".json": "json",
     ".lock": "#",  # Cargo.lock
 }

@@ -1,7 +1,8 @@
 """The simulated flight controller's parameters and how it reads the RC pulses, as ArduCopter does.
 
 Parameters come from ``arducopter.yaml`` (ArduCopter's names and defaults, plus the airframe), overridden by
-the generated parameter file the user loads into the real flight controller (``generated/ardupilot/drone.parm``):
+the generated parameter file the user loads into the real flight controller
+(``generated/ardupilot/arducopter-4/drone.parm``):
 so the simulator flies with the same RC ranges, reversals, dead band, failsafe and mode slots.
 
 Stick reading follows ArduPilot's RC_Channel: roll, pitch and yaw are angles in -4500..4500 around the trim
@@ -25,7 +26,7 @@ from .randomise import Effects
 
 HERE = Path(__file__).resolve().parent
 PARAMS_YAML = HERE / "arducopter.yaml"
-REPO_PARM = HERE.parents[1] / "generated" / "ardupilot" / "drone.parm"
+REPO_PARM = HERE.parents[1] / "generated" / "ardupilot" / "arducopter-4" / "drone.parm"
 STICKS = (dp.ChannelName.ROLL, dp.ChannelName.PITCH, dp.ChannelName.THROTTLE, dp.ChannelName.YAW)
 MODE_SLOT_BOUNDS_US = (1230, 1360, 1490, 1620, 1749)  # ArduPilot's read_6pos_switch
 ANGLE_RANGE = 4500.0

@@ -14,9 +14,9 @@ from generator.render import header_lines, render_all
 from generator.targets import comment_style
 
 # What each format accepts as a comment: the header's first line must start with it.
-OPENERS = {".properties": "# ", ".txt": "# ", ".parm": "# ", ".py": "# ", ".typed": "# ", ".h": "// ",
+OPENERS = {".properties": "# ", ".txt": "# ", ".parm": "# ", ".params": "# ", ".py": "# ", ".typed": "# ", ".h": "// ",
            ".ino": "// ", ".md": "<!--\n", ".c": "// ", ".rs": "// ", ".toml": "# ", ".lock": "# ", ".ts": "// ",
-           ".mjs": "// ", ".html": "<!--"}
+           ".mjs": "// ", ".html": "<!--", ".svg": "<!--\n"}
 
 
 def test_every_generated_file_opens_with_its_own_formats_comment() -> None:
@@ -33,7 +33,7 @@ def test_every_generated_file_opens_with_its_own_formats_comment() -> None:
         seen.add(suffix)
         assert text.startswith(OPENERS[suffix]), path
         assert notice in text.splitlines()[0] + text.splitlines()[1], path
-    assert {".properties", ".txt", ".parm", ".h", ".ino", ".py", ".md"} <= seen
+    assert {".properties", ".txt", ".parm", ".params", ".h", ".ino", ".py", ".md"} <= seen
 
 
 def test_library_properties_has_only_hash_comments_and_key_value_lines() -> None:

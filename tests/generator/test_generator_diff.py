@@ -16,7 +16,7 @@ CODE_R = ("  out_of_range:\n    code: r\n", "  out_of_range:\n    code: R\n")
 TURN_LEFT = "      l:\n        name: left\n        description: Turn left"
 TURN_RIGHT = "      r:\n        name: right\n        description: Turn right"
 ANGLE = "    range: [1, 180]"
-RELOAD = "re-load generated/ardupilot/drone.parm into the flight controller"
+RELOAD = "re-load the parameter file in generated/ardupilot/ into the flight controller"
 
 # (id, edits of the fixture, expected lines of the report without the summary, breaking?)
 PAIRS = [
@@ -59,11 +59,13 @@ PAIRS = [
      ["BREAK frame.inter_byte_timeout_ms: 20 -> 10"], True),
     # how the drone flies: a new dead band or reversal needs the flight controller's parameters loaded again
     ("throttle dead band widened", (("  throttle_dead_band: 10", "  throttle_dead_band: 100"),),
-     [f"BREAK flight_controller.THR_DZ: 10 -> 100 ({RELOAD})"], True),
+     [f"BREAK flight_controller.arducopter-{line}/THR_DZ: 10 -> 100 ({RELOAD})" for line in ("3.2", "4")], True),
     ("pitch reversal removed", (("  reversed: [pitch]", "  reversed: []"),),
-     [f"BREAK flight_controller.RC2_REVERSED: 1 -> unset (ArduCopter's default) ({RELOAD})"], True),
+     [f"BREAK flight_controller.arducopter-3.2/RC2_REV: -1 -> unset (ArduCopter's default) ({RELOAD})",
+      f"BREAK flight_controller.arducopter-4/RC2_REVERSED: 1 -> unset (ArduCopter's default) ({RELOAD})"], True),
     ("yaw reversed too", (("  reversed: [pitch]", "  reversed: [pitch, yaw]"),),
-     [f"BREAK flight_controller.RC4_REVERSED: unset -> 1 ({RELOAD})"], True),
+     [f"BREAK flight_controller.arducopter-3.2/RC4_REV: unset -> -1 ({RELOAD})",
+      f"BREAK flight_controller.arducopter-4/RC4_REVERSED: unset -> 1 ({RELOAD})"], True),
     ("speed step changed", (("  step_us: 100", "  step_us: 150"),),
      ["ok    flight.step_us: 100 -> 150 (how the drone flies: the default speeds and the landing descent)",
       *(f"ok    command {code} ({name}): default {old} -> {new}" for code, name, old, new in (

@@ -188,7 +188,7 @@ CASES = [
               "servos.pan: SERVO_PAN_MAX = 300 does not fit its C++ type uint8_t (0..255)"),)),
     Hostile("a channel no command drives, past uint16_t",
             edited(("channels:\n", "channels:\n  aux:\n    recorded: [1000, 70000]\n    movement: none\n"),
-                   ("  rc_inputs:\n", "  rc_inputs:\n    aux: 7\n")),
+                   ("    mode: 6\n", "    mode: 6\n    aux: 7\n")),  # mode stays input 5 (ArduCopter 3.2)
             (("  aux:\n    recorded: ^[",
               "channels.aux.recorded: AUX_MAX = 70000 does not fit its C++ type uint16_t"),)),
     # 10 ** width was computed before the width was bounded: a spec mutation's width of 2**31 - 1 never finished

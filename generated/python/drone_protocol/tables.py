@@ -54,7 +54,7 @@ LANDING_MS: Final = 8000
 MODE_STABILIZE_US: Final = 1165
 MODE_ALT_HOLD_US: Final = 1425
 SPEED_STEP_US: Final = 100
-#: The flight controller's parameters the spec sets (generated/ardupilot/drone.parm): how ArduCopter reads the sticks.
+#: The flight controller's parameters the spec sets (generated/ardupilot/arducopter-4/): how it reads the sticks.
 FLIGHT_CONTROLLER_PARAMETERS: Final[Mapping[str, int]] = MappingProxyType({
     "RCMAP_ROLL": 1,
     "RCMAP_PITCH": 2,

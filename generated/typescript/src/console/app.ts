@@ -48,9 +48,15 @@ export function startConsole(root: HTMLElement, bridge: string): void {
     `SAFE: ${SAFE_SEQUENCE.join(", ")}`);
   const keepAliveBox = el("input", { id: "keepalive", type: "checkbox" });
   const controls = commandControls((spec, value) => void sendCommand(spec, value));
+  // Without Web Serial the serial button stays greyed: say why on the page, not only in its tooltip.
+  const noSerial = el("p", { id: "no-web-serial", class: "notice", role: "status" },
+    "This browser cannot open a USB serial port: it has no Web Serial API. Open this page in Chromium, Chrome or ",
+    "Edge (89 or later), from a file, localhost or https:, to drive the Arduino; a WebSocket bridge still works here.");
   if (!webSerialAvailable()) {
     serialButton.disabled = true;
     serialButton.title = "this browser has no Web Serial API (use Chromium or Chrome, from https:, localhost or a file)";
+  } else {
+    noSerial.hidden = true;
   }
 
   const addLog = (direction: "sent" | "received" | "note", text: string): void => {
@@ -180,7 +186,7 @@ export function startConsole(root: HTMLElement, bridge: string): void {
 
   root.replaceChildren(
     el("header", {}, el("h1", {}, PROTOCOL_TITLE), el("p", {}, `bench console · ${PROTOCOL_NAME} · spec ${SPEC_FINGERPRINT}`)),
-    el("section", { class: "link" }, serialButton, " or ", bridgeUrl, bridgeButton, closeButton, " ", status),
+    el("section", { class: "link" }, noSerial, serialButton, " or ", bridgeUrl, bridgeButton, closeButton, " ", status),
     el("section", { class: "drone" }, ready, failsafe, el("div", {}, "drone: ", state),
       el("div", {}, "last reply: ", lastReply), el("div", {}, "rejected: ", errors)),
     el("section", { class: "actions" }, safeButton,
