@@ -108,6 +108,11 @@ class ArucoMarkerDetector:
         """This frame alone, the best candidate (no tracking, no frame checks)."""
         return best_detection(self, image, self.cfg.marker_size_m, self.fov_deg)
 
+    @property
+    def cut_short(self) -> bool:
+        """Never: a marker look is one OpenCV call (two at most) of a bounded cost."""
+        return False
+
     def aim_on_target(self, image: MatLike, size: float) -> bool | None:
         """Not measured: a marker is black and white like much else, and a marker partly covered is not read."""
         return None

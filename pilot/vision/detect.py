@@ -62,13 +62,14 @@ class TrackedDetector:
                 expected := self.tracker.expected()) is not None:
             candidates = candidates + self.source.candidates_near(image, *expected)
         out = self.tracker.update(candidates, w)
+        cut = self.source.cut_short
         if out is None:
-            return Detection(False, width=w, height=h)
+            return Detection(False, width=w, height=h, cut_short=cut)
         c = out.candidate
         distance = range_of(c.size, self.object_m, w, self.fov_deg)
         aim = None if out.predicted else self.source.aim_on_target(image, c.size)
         return Detection(True, c.cx, c.cy, c.size, c.score, w, h, range_m=distance, predicted=out.predicted,
-                         aim_on_target=aim)
+                         aim_on_target=aim, cut_short=cut)
 
 
 def make_detector(config: PilotConfig) -> TrackedDetector:
