@@ -66,6 +66,9 @@ class TrackedDetector:
         if out is None:
             return Detection(False, width=w, height=h, cut_short=cut)
         c = out.candidate
+        if not (0.0 <= c.cx < w and 0.0 <= c.cy < h):  # a bridged target gone past the frame's edge: lost, not
+            self.tracker.reset()  # reported where no pixel shows it (a marker was logged at cx -61)
+            return Detection(False, width=w, height=h, cut_short=cut)
         distance = range_of(c.size, self.object_m, w, self.fov_deg)
         aim = None if out.predicted else self.source.aim_on_target(image, c.size)
         return Detection(True, c.cx, c.cy, c.size, c.score, w, h, range_m=distance, predicted=out.predicted,
