@@ -36,6 +36,7 @@ class HsvConfig:
     open_kernel: int = 3
     target_diameter_m: float = 0.30  # the ball's diameter: apparent size -> range
     min_score: float = 0.2  # candidates scoring below this are not reported at all
+    colour_model: str = ""  # the room's learnt colour model (pilot --calibrate BALL --room EMPTY); "": none
 
 
 @dataclass(frozen=True)
