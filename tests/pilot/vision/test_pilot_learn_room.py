@@ -16,7 +16,7 @@ from cli_rig import call
 import pilot.vision.colour_model as cm
 from pilot.common.config import HsvConfig, PilotConfig, load
 from pilot.common.errors import ConfigError
-from pilot.vision.calibrate_room import learn_room
+from pilot.vision.calibrate_room import learn_room, read_frames
 from pilot.vision.detect import make_detector
 from pilot.vision.hsv.detector import HsvBlobDetector
 
@@ -135,3 +135,17 @@ def test_a_good_model_file_loads_and_mirrors_for_red(tmp_path: Path) -> None:
     assert model.threshold == 100.0 and (model.width, model.height) == (320, 240)
     det = HsvBlobDetector(HsvConfig(colour_model=str(path)))  # the default red: its hue circle mirrored
     assert det.colour.model is not None and det.colour.code == cv2.COLOR_RGB2HSV
+
+
+def test_a_short_video_of_the_ball_is_read_frame_by_frame(tmp_path: Path) -> None:
+    video = tmp_path / "ball.avi"
+    writer = cv2.VideoWriter(str(video), cv2.VideoWriter.fourcc(*"MJPG"), 10.0, (320, 240))
+    for s in range(8):
+        writer.write(with_ball(room(s), 150 + 3 * s, 120))
+    writer.release()
+    report = learn_room([str(video)], frames(tmp_path, "room", [room(20 + s) for s in range(3)]),
+                        tmp_path / "pilot.yaml", None, (320, 240))
+    assert report.ball_found == 1.0 and report.room_detections == 0.0
+    assert len(read_frames(video, (320, 240))) == 4  # every other frame of the eight
+    with pytest.raises(ConfigError, match=r"ball\.avi.*320x240"):
+        read_frames(video, (640, 480))
