@@ -6,7 +6,6 @@ detection, on the held-out photos (scikit-image's) and the bench photos (avr-lib
 
 from __future__ import annotations
 
-import argparse
 import sys
 
 import vision_eval as ve
@@ -19,11 +18,8 @@ THRESHOLD = 0.6  # controller.acquire_confidence
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__)
-    p.add_argument("--markers", type=int, default=200, help="markers per condition and source")
-    p.add_argument("--empty", type=int, default=500, help="empty views per source")
-    p.add_argument("--seed", type=int, default=61)
-    args = p.parse_args(argv)
+    args = ve.counts_args(__doc__, argv, markers=(200, "markers per condition and source"),
+                          empty=(500, "empty views per source"), seed=(61, "seed"))
     print("| source | " + " | ".join(CONDITIONS) + " | empty views detected | distractor views detected |")
     print("|---|" + "---|" * (len(CONDITIONS) + 2))
     for k, (name, split) in enumerate((("held-out", vi.HELD_OUT), ("bench", vi.BENCH))):

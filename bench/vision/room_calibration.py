@@ -8,7 +8,6 @@ condition), and with the ball anywhere (recall, targets from 16 px). The goal: a
 
 from __future__ import annotations
 
-import argparse
 import sys
 import tempfile
 from pathlib import Path
@@ -64,11 +63,8 @@ def measure(name: str, seed: int, empty: int, targets: int) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__)
-    p.add_argument("--empty", type=int, default=1000, help="empty views per room")
-    p.add_argument("--targets", type=int, default=200, help="views with the ball per room")
-    p.add_argument("--seed", type=int, default=7)
-    args = p.parse_args(argv)
+    args = ve.counts_args(__doc__, argv, empty=(1000, "empty views per room"),
+                          targets=(200, "views with the ball per room"), seed=(7, "seed"))
     budget.CLOCK = lambda: 0.0  # judged on what the detector sees: the budget's figures are run.py's timing
     print("| room | ball's / room's pixels kept | empty views detected, model | without | recall, model | without |")
     print("|---|---|---|---|---|---|")

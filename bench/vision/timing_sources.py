@@ -7,7 +7,6 @@ Wall time on a shared machine includes other processes' turns; CPU time (the thr
 
 from __future__ import annotations
 
-import argparse
 import statistics
 import sys
 import time
@@ -15,6 +14,7 @@ from collections.abc import Callable
 
 import cv2
 import numpy as np
+import vision_eval as ve
 import vision_imagery as vi
 
 from pilot.vision.hsv.detector import HsvBlobDetector
@@ -49,10 +49,7 @@ def pct(v: list[float], q: float) -> float:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__)
-    p.add_argument("--views", type=int, default=100, help="views per photo at 320x240")
-    p.add_argument("--seed", type=int, default=99)
-    args = p.parse_args(argv)
+    args = ve.counts_args(__doc__, argv, views=(100, "views per photo at 320x240"), seed=(99, "seed"))
     cv2.setNumThreads(1)
     rng = np.random.default_rng(args.seed)
     print("| photo | floor median (ms) | HSV median, wall / CPU (ms) | HSV p99, wall / CPU (ms) | frames cut short |")

@@ -37,6 +37,7 @@ class HsvConfig:
     target_diameter_m: float = 0.30  # the ball's diameter: apparent size -> range
     min_score: float = 0.2  # candidates scoring below this are not reported at all
     colour_model: str = ""  # the room's learnt colour model (pilot --calibrate BALL --room EMPTY); "": none
+    simple: bool = False  # the simpler detector (pilot/vision/ball.py) instead of the rule-grown one (hsv/)
 
 
 @dataclass(frozen=True)

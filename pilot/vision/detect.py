@@ -19,6 +19,7 @@ from cv2.typing import MatLike
 from ..common.config import PilotConfig, VisionConfig
 from ..common.errors import ConfigError
 from .aruco import ArucoMarkerDetector, aruco_dictionary
+from .ball import SimpleBallDetector
 from .detection import CandidateSource, Detection, Detector, FrameStatus, range_of, reported_size
 from .frames import FrameCheck
 from .hsv.detector import HsvBlobDetector
@@ -79,7 +80,8 @@ def make_detector(config: PilotConfig) -> TrackedDetector:
     fov = config.controller.horizontal_fov_deg
     source: CandidateSource
     if config.detector == "hsv":
-        source, size = HsvBlobDetector(config.hsv, config.vision, fov), config.hsv.target_diameter_m
+        ball = SimpleBallDetector if config.hsv.simple else HsvBlobDetector
+        source, size = ball(config.hsv, config.vision, fov), config.hsv.target_diameter_m
     elif config.detector == "aruco":
         source, size = ArucoMarkerDetector(config.aruco, config.vision, fov), config.aruco.marker_size_m
     else:
