@@ -29,7 +29,8 @@ from pilot.vision.aruco import ArucoMarkerDetector
 from pilot.vision.hsv.detector import HsvBlobDetector
 
 HERE = Path(__file__).resolve().parent
-ARUCO_CONDITIONS = ("clean", "perspective", "gaussian_blur", "motion_blur", "jpeg", "dim", "noise", "occlusion", "edge")
+ARUCO_CONDITIONS = ("clean", "perspective", "gaussian_blur", "motion_blur", "jpeg", "dim", "noise", "occlusion", "edge",
+                    "corner")
 BALL_SIZES, MARKER_SIZES = (10.0, 120.0), (24.0, 120.0)
 VIEWS = 400  # per condition: about 320 targets of 16 px or more, a binomial spread of 1.6 points at 90 % (at 100
 # views, 3.3 points: the worst of nine conditions then reads several points under the detector's true recall)

@@ -10,6 +10,7 @@ candidates.
 
 from __future__ import annotations
 
+import argparse
 import math
 import statistics
 from collections.abc import Callable, Iterable
@@ -131,3 +132,11 @@ def overall(records: list[Record], threshold: float, min_size: float) -> tuple[f
     empty = false_rows(records, threshold, "empty")[-1].rate
     distr = false_rows(records, threshold, "distractor")[-1].rate
     return worst, rows.get("occlusion", math.nan), empty, distr
+
+
+def counts_args(doc: str | None, argv: list[str] | None, **defaults: tuple[int, str]) -> argparse.Namespace:
+    """The command line of a goal script: one integer option per ``defaults`` entry (default, help)."""
+    p = argparse.ArgumentParser(description=doc)
+    for name, (default, text) in defaults.items():
+        p.add_argument(f"--{name}", type=int, default=default, help=text)
+    return p.parse_args(argv)

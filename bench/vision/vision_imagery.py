@@ -38,6 +38,7 @@ CONDITIONS = ("clean", "perspective", "gaussian_blur", "motion_blur", "jpeg", "d
 FULL_GAIN = "full_gain"  # a dark room at the camera's full gain (the simulator's `dim` room): reported apart, no goal
 DISTRACTOR_KINDS = ("orange", "pink", "red_brown", "red_shape", "red_poster")
 MARKER_DICT, MARKER_ID = cv2.aruco.DICT_4X4_50, 7
+CORNER_SHARE = 0.12  # of a marker's black square covered at one corner (ArUco's ``corner`` condition)
 
 
 @cache
@@ -139,8 +140,9 @@ def occlude(img: Image, cx: float, cy: float, diameter: float, share: float, rng
     img[inside] = np.clip(colour + texture[inside], 0, 255).astype(np.uint8)
 
 
-def marker(img: Image, cx: float, cy: float, side: float, rng: np.random.Generator) -> None:
-    """An ArUco marker on white paper (a quarter-side quiet zone), rotated and seen slightly obliquely."""
+def marker(img: Image, cx: float, cy: float, side: float, rng: np.random.Generator) -> FloatArray:
+    """An ArUco marker on white paper (a quarter-side quiet zone), rotated and seen slightly obliquely; the corners
+    of its black square."""
     cells = 6
     px = cells * 20
     m = cv2.aruco.generateImageMarker(cv2.aruco.getPredefinedDictionary(MARKER_DICT), MARKER_ID, px)
@@ -161,6 +163,24 @@ def marker(img: Image, cx: float, cy: float, side: float, rng: np.random.Generat
     paper_bgr = (warped.astype(np.float64) * gain)[..., None] * np.array([0.95, 1.0, 1.0])
     out = img.astype(np.float64) * (1 - cover[..., None]) + paper_bgr * cover[..., None]
     img[:] = np.clip(out, 0, 255).astype(np.uint8)
+    square = np.array([[pad, pad], [pad + px, pad], [pad + px, pad + px], [pad, pad + px]], np.float32)
+    return np.asarray(cv2.perspectiveTransform(square[None], hm)[0], np.float64)
+
+
+def cover_corner(img: Image, corners: FloatArray, share: float, rng: np.random.Generator) -> None:
+    """Cover ``share`` of a marker's black square at one of its corners, with a dull, textured object reaching
+    in from outside along the marker's sides (a hand or a shelf's edge)."""
+    k = int(rng.integers(4))
+    c, a, b = corners[k], corners[(k + 1) % 4], corners[(k - 1) % 4]
+    t = math.sqrt(share)  # a square of t x t sides at the corner covers share of the marker
+    ua, ub = (a - c) * t, (b - c) * t
+    poly = np.array([c - ua - ub, c + ua - ub, c + ua + ub, c - ua + ub], np.float64)
+    mask = np.zeros(img.shape[:2], np.uint8)
+    cv2.fillConvexPoly(mask, np.round(poly).astype(np.int32), 255)
+    colour = rng.uniform(40, 200, 3) * np.array([1.0, 1.0, 0.7])
+    texture = rng.normal(0, 10, img.shape)
+    inside = mask > 0
+    img[inside] = np.clip(colour + texture[inside], 0, 255).astype(np.uint8)
 
 
 def _ball_of(img: Image, rng: np.random.Generator, hue: tuple[float, float], sat: tuple[float, float],
@@ -283,10 +303,12 @@ def target_sample(rng: np.random.Generator, photos: tuple[str, ...], condition: 
         if condition == "occlusion":
             occlude(img, cx, cy, d, 0.3, rng)
     else:
-        marker(img, cx, cy, d, rng)
+        corners = marker(img, cx, cy, d, rng)
         if condition == "occlusion":
             occlude(img, cx, cy, d * 1.414, 0.3, rng)
-    out, hm = degrade(img, "clean" if condition in ("occlusion", "edge") else condition, rng)
+        elif condition == "corner":
+            cover_corner(img, corners, CORNER_SHARE, rng)
+    out, hm = degrade(img, "clean" if condition in ("occlusion", "edge", "corner") else condition, rng)
     tx, ty = map_point(hm, cx, cy)
     return Sample(out, "target", condition, d, tx, ty, name)
 

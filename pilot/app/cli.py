@@ -5,6 +5,7 @@
     pilot --port /dev/ttyACM0 --arm --camera 0
     pilot --video flight.mp4 --dry-run       # decide and print the commands, send nothing
     pilot --calibrate sample.png --config pilot.yaml   # HSV ranges from a sample image into the config
+    pilot --calibrate ball*.png --room empty*.png --config pilot.yaml   # learn the room's colour model
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from ..control.controller import Controller, State
 from ..link.protocol_needs import protocol_problem
 from ..link.serial_link import Link, LogEntry, keepalive_ms
 from ..vision.calibrate import Roi, calibrate_to_config, preview_path
+from ..vision.calibrate_room import learn_room, room_summary
 from ..vision.detect import make_detector
 from ..vision.picam import PicameraSource
 from .cli_options import LiveSession, check_sources, port_error_hint, stop_note
@@ -85,7 +87,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--virtual-drone", help="the virtual drone executable (default: the firmware's host build)")
     p.add_argument("--no-status", action="store_true", help="no status line")
     cal = p.add_argument_group("calibration")
-    cal.add_argument("--calibrate", metavar="IMAGE", help="pick HSV ranges from IMAGE and save them to --config")
+    cal.add_argument("--calibrate", metavar="IMAGE", nargs="+",
+                     help="pick HSV ranges from IMAGE and save them to --config; with --room: learn the room's colour "
+                          "model from frames (images or a short video) of the ball held in the middle of the view")
+    cal.add_argument("--room", metavar="FRAMES", nargs="+",
+                     help="with --calibrate: frames (images or a short video) of the room without the ball, at the "
+                          "camera's size (--size)")
     cal.add_argument("--roi", help="x,y,w,h of the target in the calibration image (default: the central 20%%)")
     return p
 
@@ -337,8 +344,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if args.calibrate:
             if not args.config:
-                raise PilotError("option --calibrate needs --config FILE to save the ranges into")
-            cfg = calibrate_to_config(args.calibrate, args.config, _roi(args.roi))
+                raise PilotError("option --calibrate needs --config FILE to save the calibration into")
+            if args.room:
+                report = learn_room(args.calibrate, args.room, args.config, _roi(args.roi), _size(args.size))
+                print(room_summary(report))
+                return EXIT_OK
+            if len(args.calibrate) > 1:
+                raise PilotError("option --calibrate: one sample image, or frames of the ball with --room FRAMES")
+            cfg = calibrate_to_config(args.calibrate[0], args.config, _roi(args.roi))
             print(f"pilot: saved HSV ranges {cfg.hsv.ranges} to {args.config}; preview {preview_path(args.config)}")
             return EXIT_OK
         if (problem := protocol_problem()) is not None:  # a spec edit the pilot cannot fly with

@@ -114,6 +114,7 @@ class Recorder(Closing):
                     "cy": round(det.cy, 2),
                     "size": round(det.size, 2),
                     "confidence": round(det.confidence, 3),
+                    "cut_short": det.cut_short,
                 },
                 "command": tick.command.decode("ascii", "replace") if tick.command else None,
                 "replies": [_reply_text(r) for r in tick.replies],

@@ -36,6 +36,8 @@ class HsvConfig:
     open_kernel: int = 3
     target_diameter_m: float = 0.30  # the ball's diameter: apparent size -> range
     min_score: float = 0.2  # candidates scoring below this are not reported at all
+    colour_model: str = ""  # the room's learnt colour model (pilot --calibrate BALL --room EMPTY); "": none
+    simple: bool = False  # the simpler detector (pilot/vision/ball.py) instead of the rule-grown one (hsv/)
 
 
 @dataclass(frozen=True)
@@ -47,6 +49,8 @@ class VisionConfig:
     bridge_frames: int = 3  # missed frames the tracker predicts through
     max_jump: float = 0.2  # fraction of the frame width a tracked target may move in one frame
     frozen_frames: int = 5  # identical frames in a row that make the camera count as frozen
+    # per-frame detection budget, ms (a quarter of the 20 Hz tick): past it a detector keeps its best candidate so far
+    budget_ms: float = 12.5
 
 
 @dataclass(frozen=True)
@@ -280,6 +284,8 @@ def _validate_vision(config: PilotConfig, where: str) -> None:
     _in(where, "vision.bridge_frames", v.bridge_frames, 0, 30)
     _in(where, "vision.max_jump", v.max_jump, 0.01, 1.0)
     _in(where, "vision.frozen_frames", v.frozen_frames, 2, 1000)
+    # past the tick the loop would miss it whatever the frame shows
+    _in(where, "vision.budget_ms", v.budget_ms, 0.1, 1000.0 / config.link.rate_hz)
     _in(where, "controller.horizontal_fov_deg", c.horizontal_fov_deg, 10.0, 170.0)
     _in(where, "controller.acquire_confidence", c.acquire_confidence, 0.05, 1.0)
     _in(where, "controller.confirm_frames", c.confirm_frames, 1, 100)

@@ -17,10 +17,14 @@ blur and at the frame's edge, zero false positives, and a cost near OpenCV's def
 * Sub-pixel corner refinement: the centre and the side (hence the range) to a fraction of a pixel.
 * A second look at half resolution when the full frame has no marker: motion blur halves with the image
   and the look costs a quarter of the first.
+* A third, while the frame's budget (``vision.budget_ms``) lasts: a marker with one corner covered
+  (aruco_corner.py), which OpenCV's quadrilaterals miss; scored ``CORNER_SCORE``.
 Every marker of the configured id is a candidate; its size must imply a plausible range.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable, Sequence
 
 import cv2
 import numpy as np
@@ -28,6 +32,8 @@ from cv2.typing import MatLike
 
 from ..common.config import ArucoConfig, VisionConfig
 from ..common.errors import ConfigError
+from .aruco_corner import corner_covered_markers, reference_cells
+from .budget import FrameBudget
 from .detection import Candidate, Detection, best_detection, frame_size, malformed, range_of
 
 
@@ -39,6 +45,9 @@ def aruco_dictionary(name: str) -> cv2.aruco.Dictionary:
 
 
 MIN_SIDE_PX = 8  # the smallest marker side searched, pixels of the searched image
+CORNER_SCORE = 0.8  # a marker read with a corner covered: above the acquisition threshold, below a whole one
+CORNER_MIN_SIDE = 20  # px: a covered marker's cells are read from 3 px and more (a 9 px quad of a red shape's
+# texture matched the marker's cells with one to spare)
 
 
 def detector_parameters(adaptive_thresh_constant: float, searched_width: int = 320) -> cv2.aruco.DetectorParameters:
@@ -60,8 +69,10 @@ class ArucoMarkerDetector:
     name = "aruco"
 
     def __init__(
-        self, config: ArucoConfig | None = None, vision: VisionConfig | None = None, fov_deg: float = 60.0
+        self, config: ArucoConfig | None = None, vision: VisionConfig | None = None, fov_deg: float = 60.0,
+        clock: Callable[[], float] | None = None,
     ) -> None:
+        """``clock``: seconds, for the frame's budget (default ``pilot.vision.budget.CLOCK``)."""
         cfg = config or ArucoConfig()
         self.cfg = cfg
         self.marker_id = cfg.marker_id
@@ -69,6 +80,8 @@ class ArucoMarkerDetector:
         self.fov_deg = fov_deg
         self._dictionary = aruco_dictionary(cfg.dictionary)
         self._detectors: dict[int, cv2.aruco.ArucoDetector] = {}  # per searched width (the minimum perimeter)
+        self._references = reference_cells(self._dictionary, max(0, cfg.marker_id))
+        self.budget = FrameBudget(self.vision.budget_ms, clock)
 
     def _detector(self, searched_width: int) -> cv2.aruco.ArucoDetector:
         det = self._detectors.get(searched_width)
@@ -81,32 +94,46 @@ class ArucoMarkerDetector:
         corners, ids, _ = self._detector(max(grey.shape[:2])).detectMarkers(grey)
         if ids is None or len(corners) == 0:
             return []
+        quads = [q for q, m in zip(corners, np.asarray(ids).reshape(-1), strict=True)
+                 if self.marker_id < 0 or int(m) == self.marker_id]
+        return self._placed(quads, scale, width, 1.0)
+
+    def _placed(self, quads: Sequence[MatLike], scale: float, width: int, score: float) -> list[Candidate]:
+        """The markers of ``quads`` (corners in a ``scale`` times smaller image) whose size implies a plausible
+        range, as candidates scored ``score``, largest first."""
         found = []
-        for quad, marker in zip(corners, np.asarray(ids).reshape(-1), strict=True):
-            if self.marker_id >= 0 and int(marker) != self.marker_id:
-                continue
+        for quad in quads:
             pts = np.asarray(quad, dtype=np.float64).reshape(4, 2) * scale
             side = float(np.linalg.norm(pts - np.roll(pts, 1, axis=0), axis=1).mean())
             distance = range_of(side, self.cfg.marker_size_m, width, self.fov_deg)
             if self.vision.range_min_m <= distance <= self.vision.range_max_m:
                 centre = pts.mean(axis=0)
-                found.append(Candidate(float(centre[0]), float(centre[1]), side, 1.0))
+                found.append(Candidate(float(centre[0]), float(centre[1]), side, score))
         return sorted(found, key=lambda c: c.size, reverse=True)
 
     def candidates(self, image: MatLike) -> list[Candidate]:
         """Every candidate, best first; an empty list for a frame ``detection.malformed`` names (no OpenCV error)."""
         if malformed(image) is not None:
             return []
+        self.budget.start()
         grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
         width = frame_size(image)[0]
         found = self._markers(grey, 1.0, width)
         if not found:
             found = self._markers(cv2.pyrDown(grey), 2.0, width)  # pyrDown's pixel j is centred on pixel 2j
+        if not found and self.marker_id >= 0:  # one id to match: a covered corner's few cells are enough
+            covered = corner_covered_markers(grey, self._references, CORNER_MIN_SIDE, lambda: not self.budget.out())
+            found = self._placed(covered, 1.0, width, CORNER_SCORE)
         return found
 
     def detect(self, image: MatLike) -> Detection:
         """This frame alone, the best candidate (no tracking, no frame checks)."""
         return best_detection(self, image, self.cfg.marker_size_m, self.fov_deg)
+
+    @property
+    def cut_short(self) -> bool:
+        """Whether the last frame's covered-corner look stopped at the frame's budget."""
+        return self.budget.exhausted
 
     def aim_on_target(self, image: MatLike, size: float) -> bool | None:
         """Not measured: a marker is black and white like much else, and a marker partly covered is not read."""

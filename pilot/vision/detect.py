@@ -19,6 +19,7 @@ from cv2.typing import MatLike
 from ..common.config import PilotConfig, VisionConfig
 from ..common.errors import ConfigError
 from .aruco import ArucoMarkerDetector, aruco_dictionary
+from .ball import SimpleBallDetector
 from .detection import CandidateSource, Detection, Detector, FrameStatus, range_of, reported_size
 from .frames import FrameCheck
 from .hsv.detector import HsvBlobDetector
@@ -62,20 +63,25 @@ class TrackedDetector:
                 expected := self.tracker.expected()) is not None:
             candidates = candidates + self.source.candidates_near(image, *expected)
         out = self.tracker.update(candidates, w)
+        cut = self.source.cut_short
         if out is None:
-            return Detection(False, width=w, height=h)
+            return Detection(False, width=w, height=h, cut_short=cut)
         c = out.candidate
+        if not (0.0 <= c.cx < w and 0.0 <= c.cy < h):  # a bridged target gone past the frame's edge: lost, not
+            self.tracker.reset()  # reported where no pixel shows it (a marker was logged at cx -61)
+            return Detection(False, width=w, height=h, cut_short=cut)
         distance = range_of(c.size, self.object_m, w, self.fov_deg)
         aim = None if out.predicted else self.source.aim_on_target(image, c.size)
         return Detection(True, c.cx, c.cy, c.size, c.score, w, h, range_m=distance, predicted=out.predicted,
-                         aim_on_target=aim)
+                         aim_on_target=aim, cut_short=cut)
 
 
 def make_detector(config: PilotConfig) -> TrackedDetector:
     fov = config.controller.horizontal_fov_deg
     source: CandidateSource
     if config.detector == "hsv":
-        source, size = HsvBlobDetector(config.hsv, config.vision, fov), config.hsv.target_diameter_m
+        ball = SimpleBallDetector if config.hsv.simple else HsvBlobDetector
+        source, size = ball(config.hsv, config.vision, fov), config.hsv.target_diameter_m
     elif config.detector == "aruco":
         source, size = ArucoMarkerDetector(config.aruco, config.vision, fov), config.aruco.marker_size_m
     else:

@@ -63,6 +63,7 @@ class Detection:
     status: FrameStatus = FrameStatus.OK
     predicted: bool = False  # bridged by the tracker through a missed frame, not measured in this one
     aim_on_target: bool | None = None  # the laser's aim point shows the target itself (None: not measured)
+    cut_short: bool = False  # the frame's time budget ran out: the best candidate found before it
 
     @property
     def error_x(self) -> float:
@@ -91,6 +92,11 @@ class CandidateSource(Protocol):
     an OpenCV error)."""
 
     name: str
+
+    @property
+    def cut_short(self) -> bool:
+        """Whether the last ``candidates`` stopped at the frame's time budget (``vision.budget_ms``)."""
+        ...
 
     def candidates(self, image: MatLike) -> list[Candidate]: ...
 

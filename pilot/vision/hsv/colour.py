@@ -19,6 +19,7 @@ from cv2.typing import MatLike
 
 from ...common.config import HsvConfig
 from ...common.errors import ConfigError
+from ..colour_model import ColourModel, load
 from .noise import SMOOTH_SIGMA, noisy
 
 V_REFERENCE = 200  # brightness (see exposure) of a well-exposed frame; the V bound scales below it
@@ -92,6 +93,11 @@ class ColourMask:
             ((s_lo, v_lo), (s_hi, v_hi)), = sv
             ranges = [(np.array((span[0], s_lo, v_lo), np.uint8), np.array((span[1], s_hi, v_hi), np.uint8))]
         self.ranges = ranges
+        # the room's colour model (checked here, at start): of the ranges' mask, only the colours it gives the ball
+        self.model: ColourModel | None = None
+        if cfg.colour_model:
+            model = load(cfg.colour_model)
+            self.model = model.mirrored() if self.code == cv2.COLOR_RGB2HSV else model
         # colour purity refers to the hue range's middle and half-width (in the space the mask uses)
         used = hues if self.code == cv2.COLOR_BGR2HSV else mirrored
         self.hue_mid = (min(used) + max(used)) / 2.0
@@ -139,10 +145,11 @@ class ColourMask:
     def raw(self, image: MatLike, bounds: Bounds) -> MatLike:
         return self.in_range(cv2.cvtColor(image, self.code), bounds)
 
-    @staticmethod
-    def in_range(hsv: MatLike, bounds: Bounds, dst: MatLike | None = None) -> MatLike:
-        """The mask of ``bounds`` (written into ``dst`` where it can be: not a grown one)."""
-        return bounds.mask(hsv) if isinstance(bounds, Grown) else _in_range(hsv, bounds, dst)
+    def in_range(self, hsv: MatLike, bounds: Bounds, dst: MatLike | None = None) -> MatLike:
+        """The mask of ``bounds`` (written into ``dst`` where it can be: not a grown one), and of the room's
+        colour model if there is one."""
+        mask = bounds.mask(hsv) if isinstance(bounds, Grown) else _in_range(hsv, bounds, dst)
+        return mask if self.model is None else cv2.bitwise_and(mask, self.model.mask(hsv), dst=mask)
 
     def clean(self, mask: MatLike) -> MatLike:
         if self.kernel is None:

@@ -92,7 +92,9 @@ there, or any blob from ``HALF_MEASURE`` px, skips the refinement and its fixed 
 
 from __future__ import annotations
 
+import logging
 import math
+from collections.abc import Callable
 
 import cv2
 from cv2.typing import MatLike
@@ -109,6 +111,8 @@ from .refine import EDGE_BLOBS, SEARCH_FILL, SPLIT_BLOBS, Box, WindowRefiner, is
 from .score import SIZE, Features, arc_score
 from .search import SEARCH_MIN_WIDTH, SearchFrames
 from .texture import SearchBlob, textured
+
+log = logging.getLogger(__name__)
 
 MAX_CANDIDATES = 4  # the largest search blobs refined; smaller ones cannot be the nearest target
 HALF_MEASURE = 48  # px across (full resolution): a search blob this wide is measured at half resolution
@@ -137,13 +141,17 @@ class HsvBlobDetector(WindowRefiner):
     name = "hsv"
 
     def __init__(
-        self, config: HsvConfig | None = None, vision: VisionConfig | None = None, fov_deg: float = 60.0
+        self, config: HsvConfig | None = None, vision: VisionConfig | None = None, fov_deg: float = 60.0,
+        clock: Callable[[], float] | None = None,
     ) -> None:
+        """``clock``: seconds, for the frame's budget (``vision.budget_ms``; default ``time.perf_counter``)."""
         super().__init__(config or HsvConfig(), vision or VisionConfig(), fov_deg)
         self._blobs: list[SearchBlob] = []  # the first look's search blobs, where the circle look searches
         self._tried: set[tuple[float, Box]] = set()  # the first look's blobs split or cut by edges (area, box)
         self._plain_ok: dict[int, Features] = {}  # this frame's blobs found plain inside (by id, kept alive)
         self._frames = SearchFrames(self.colour)  # the search's frame, HSV and mask, in buffers kept
+        if clock is not None:
+            self.budget.clock = clock
 
     @property
     def single_range(self) -> bool:
@@ -159,6 +167,7 @@ class HsvBlobDetector(WindowRefiner):
         """Every refined blob's features (unscored): a second look with a lower V bound when the first found
         nothing scoring ``SECOND_LOOK_UNLESS``, a smoothed look in a noisy frame, a rim look and a circle look."""
         w = frame_size(image)[0]
+        self.budget.start()
         self.new_frame(w)
         self._windows.clear()
         self._plain_ok.clear()
@@ -230,8 +239,9 @@ class HsvBlobDetector(WindowRefiner):
         return [*kept, f]
 
     def _enough(self, found: list[Features], width: int) -> bool:
-        """Whether a look found something the pilot would act on (no further look then)."""
-        return any(self.score(f, width) >= SECOND_LOOK_UNLESS for f in found)
+        """Whether a look found something the pilot would act on, or the frame's time is spent (no further look
+        then)."""
+        return self.budget.out() or any(self.score(f, width) >= SECOND_LOOK_UNLESS for f in found)
 
     def _circle_look(self, image: MatLike, bounds: Bounds) -> list[Features]:
         """The circles in the first look's largest blobs' windows (circles.py). ``features`` merges each,
@@ -242,6 +252,8 @@ class HsvBlobDetector(WindowRefiner):
         out: list[Features] = []
         k = self.search_scale
         for _, _, (x, y, bw, bh) in sorted(self._blobs, key=lambda b: b[0], reverse=True)[:CIRCLE_BLOBS]:
+            if self.budget.out():
+                break
             if max(bw, bh) * k < SIZE[1]:
                 continue
             x0, y0, roi, hsv, mask = self._blob_window(image, bounds, (x * k, y * k, bw * k, bh * k))
@@ -252,6 +264,8 @@ class HsvBlobDetector(WindowRefiner):
         """The blobs held down by their arcs or ring measured again with their rim support; each replaces its
         first measure when it scores higher."""
         for d in self.deferred[:RIM_LOOKS]:
+            if self.budget.out():
+                break
             f = self.measure(d.hsv, d.mask, d.contour, d.area, d.x0, d.y0, d.scale, bgr=d.bgr, rim=True)
             if f is not None and (s := self.score(f, self._width)) >= d.keep_from:
                 found = self._with(found, f, s)
@@ -292,7 +306,9 @@ class HsvBlobDetector(WindowRefiner):
             self._tried.clear()
         found: list[Features] = []
         unrefined: list[SearchBlob] = []  # balls in the search, nothing measured in their windows
-        for area, c, (x, y, bw, bh) in boxes[:MAX_CANDIDATES]:
+        for i, (area, c, (x, y, bw, bh)) in enumerate(boxes[:MAX_CANDIDATES]):
+            if i and self.budget.out():  # the largest blob is always measured: the best candidate so far
+                break
             across = max(bw, bh) * scale if scale > 1 else 0  # searched at full resolution: refined as it is
             # below HALF_MEASURE, the look at half resolution counts only if it decides (and stops when it cannot)
             decide = across < HALF_MEASURE
@@ -309,7 +325,7 @@ class HsvBlobDetector(WindowRefiner):
                                              or self.measure(small_hsv, mask, c, area, 0, 0, scale) is not None):
                     unrefined.append((area, c, (x, y, bw, bh)))
             found += [f for f in fs if is_new(f, found)]
-        good = not splits or any(self.score(f, w) >= SPLIT_UNLESS for f in found)
+        good = not splits or self.budget.out() or any(self.score(f, w) >= SPLIT_UNLESS for f in found)
         if (joined or unrefined) and not good:
             joined.sort(key=lambda b: b[0], reverse=True)
             joined, unrefined = _untried(joined[:SPLIT_BLOBS], tried), _untried(unrefined, tried)
@@ -322,7 +338,7 @@ class HsvBlobDetector(WindowRefiner):
                 split += self._colour_split(image, bounds, small_hsv, mask, joined, scale, found + split)
             found += split
             good = any(self.score(f, w) >= SPLIT_UNLESS for f in split)
-        if blobs and not good:
+        if blobs and not good and not self.budget.out():
             # any blob: a ball with a stub of a saucer on it can fill its box like a ball, and score too low
             blobs.sort(key=lambda b: b[0], reverse=True)
             blobs = _untried(blobs[:EDGE_BLOBS], tried)
@@ -333,7 +349,18 @@ class HsvBlobDetector(WindowRefiner):
 
     def candidates(self, image: MatLike) -> list[Candidate]:
         """Every candidate, best first; an empty list for a frame ``detection.malformed`` names (no OpenCV error)."""
-        return [] if malformed(image) is not None else self._ranked(self.features(image), frame_size(image)[0])
+        if malformed(image) is not None:
+            return []
+        found = self._ranked(self.features(image), frame_size(image)[0])
+        if self.budget.exhausted:
+            log.info("hsv: frame budget of %.1f ms spent (%.1f ms): the best candidate so far kept",
+                     self.budget.budget_ms, self.budget.spent_ms())
+        return found
+
+    @property
+    def cut_short(self) -> bool:
+        """Whether the last frame's look stopped at the frame's budget (``vision.budget_ms``)."""
+        return self.budget.exhausted
 
     def _ranked(self, found: list[Features], width: int) -> list[Candidate]:
         """The blobs scoring above zero and at least ``min_score``, as candidates, best first."""
@@ -345,7 +372,7 @@ class HsvBlobDetector(WindowRefiner):
         """Where a tracked ball should be and the frame's look found nothing: that window refined with the V
         bound ``NEAR_GAIN`` times as high. The frame's bound follows its brightest part: a ball against a
         bright window darkens under it as the window fills more of the frame, while still plainly a red disc."""
-        if malformed(image) is not None:
+        if malformed(image) is not None or self.budget.out():  # the frame's time is spent: no closer look
             return []
         w, h = frame_size(image)
         self._width = w

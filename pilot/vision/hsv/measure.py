@@ -18,6 +18,7 @@ import numpy as np
 from cv2.typing import MatLike
 
 from ...common.config import HsvConfig, VisionConfig
+from ..budget import FrameBudget
 from ..detection import range_of
 from .colour import ColourMask
 from .rim import rim_support
@@ -75,6 +76,7 @@ class BlobMeasure:
         self.cfg = cfg
         self.vision = vision
         self.fov_deg = fov_deg
+        self.budget = FrameBudget(vision.budget_ms)  # refinement stops when the frame's time is spent
         self._width = 320  # of the frame being looked at (range estimates)
         self._scores: dict[int, tuple[Features, int, float]] = {}  # id -> the blob (kept alive), width, score
         self.deferred: list[Deferred] = []  # this frame's blobs held down by their arcs or ring

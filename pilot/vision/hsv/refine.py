@@ -49,7 +49,7 @@ class WindowRefiner(BlobMeasure):
         round pieces measured alone, their ring replaced by the share of their rim not walled in."""
         out: list[Features] = []
         for _, _, (x, y, bw, bh) in blobs[:EDGE_BLOBS]:
-            if max(bw, bh) * scale < MIN_SIZE:
+            if max(bw, bh) * scale < MIN_SIZE or self.budget.out():
                 continue
             x0, y0, roi, hsv, mask = self._blob_window(image, bounds, (x * scale, y * scale, bw * scale, bh * scale))
             cut = cut_by_edges(roi, mask, self.colour.kernel, self.cfg.min_area, SEARCH_FILL)
@@ -79,6 +79,8 @@ class WindowRefiner(BlobMeasure):
         out: list[Features] = []
         for sub, (px, py, pw, ph), channel in colour_pieces(hsv, mask, joined[:SPLIT_BLOBS], bounds, min_area,
                                                             SEARCH_FILL, self.colour.clean):
+            if self.budget.out():
+                break
             box = (px * scale, py * scale, pw * scale, ph * scale)
             if channel == HUE:
                 out += [f for f in self._refine(image, sub, box) if is_new(f, found + out)]
@@ -101,6 +103,8 @@ class WindowRefiner(BlobMeasure):
         out: list[Features] = []
         half = (scale - 1) / 2.0
         for r, px, py in centres[:SPLIT_PEAKS]:
+            if self.budget.out():
+                break
             f = self._refine_disc(image, bounds, px * scale + half, py * scale + half, r * scale)
             if f is not None and is_new(f, found + out):
                 out.append(f)

@@ -1,0 +1,106 @@
+"""The per-frame budget (``vision.budget_ms``): a frame full of the target's colour stops refining when the time is
+spent, keeps the best candidate found so far, says so (the Detection and the log), and never costs the tick."""
+
+from __future__ import annotations
+
+import logging
+
+import cv2
+import numpy as np
+import pytest
+
+import pilot.vision.budget as budget_mod
+from pilot.common.config import PilotConfig, VisionConfig, validate
+from pilot.common.errors import ConfigError
+from pilot.vision.budget import FrameBudget
+from pilot.vision.detect import TrackedDetector
+from pilot.vision.hsv.detector import HsvBlobDetector
+
+RED = (30, 20, 200)
+
+
+class StepClock:
+    """A clock that moves ``step_ms`` each time it is read: the more the detector does, the more time passes."""
+
+    def __init__(self, step_ms: float) -> None:
+        self.t, self.step, self.reads = 0.0, step_ms / 1e3, 0
+
+    def __call__(self) -> float:
+        self.reads += 1
+        self.t += self.step
+        return self.t
+
+
+def red_heavy() -> np.ndarray:
+    """A grey room scattered with red patches and slabs (each a blob to refine or split), and one red ball, the
+    largest round blob."""
+    rng = np.random.default_rng(3)
+    img = np.full((240, 320, 3), 110, np.uint8)
+    for _ in range(40):
+        x, y = int(rng.integers(0, 300)), int(rng.integers(0, 220))
+        cv2.rectangle(img, (x, y), (x + int(rng.integers(6, 30)), y + int(rng.integers(4, 12))), RED, -1)
+    cv2.circle(img, (250, 160), 28, (90, 90, 90), -1)  # clear the ball's surroundings
+    cv2.circle(img, (250, 160), 18, RED, -1)
+    return img
+
+
+def test_a_spent_budget_keeps_the_best_candidate_and_says_so(caplog: pytest.LogCaptureFixture) -> None:
+    img = red_heavy()
+    free = HsvBlobDetector()  # time never passes (conftest.py): every look runs
+    found = free.candidates(img)
+    assert not free.cut_short and found
+    clock = StepClock(1.0)
+    det = HsvBlobDetector(vision=VisionConfig(budget_ms=2.0), clock=clock)
+    with caplog.at_level(logging.INFO, logger="pilot.vision.hsv.detector"):
+        cut = det.candidates(img)
+    assert det.cut_short
+    assert clock.reads < 20  # a handful of checks, not the whole look
+    assert cut and abs(cut[0].cx - 250) < 2 and abs(cut[0].cy - 160) < 2  # the largest blob: the ball
+    assert any("budget of 2.0 ms spent" in r.getMessage() for r in caplog.records)
+
+
+def test_the_budget_starts_again_each_frame() -> None:
+    img = red_heavy()
+    clock = StepClock(0.0)
+    det = HsvBlobDetector(vision=VisionConfig(budget_ms=2.0), clock=clock)
+    clock.step = 1e-3
+    det.candidates(img)
+    assert det.cut_short
+    clock.step = 0.0
+    det.candidates(img)
+    assert not det.cut_short
+
+
+def test_the_tracked_detection_reports_a_cut_short_frame() -> None:
+    img = red_heavy()
+    source = HsvBlobDetector(vision=VisionConfig(budget_ms=2.0), clock=StepClock(1.0))
+    d = TrackedDetector(source, 0.3, 60.0, VisionConfig(budget_ms=2.0)).detect(img)
+    assert d.found and d.cut_short
+
+
+def test_frame_budget_is_sticky_until_the_next_frame() -> None:
+    clock = StepClock(0.0)
+    b = FrameBudget(5.0, clock)
+    b.start()
+    assert not b.out()
+    clock.t += 0.006
+    assert b.out() and b.exhausted
+    clock.t -= 0.006  # a clock read earlier cannot give the time back
+    assert b.out()
+    b.start()
+    assert not b.out()
+
+
+@pytest.mark.parametrize("value", [0.0, -1.0, 51.0])
+def test_a_budget_past_the_tick_or_not_positive_is_refused_by_name(value: float) -> None:
+    cfg = PilotConfig(vision=VisionConfig(budget_ms=value))
+    with pytest.raises(ConfigError, match=r"vision\.budget_ms"):
+        validate(cfg, "pilot.yaml")
+
+
+def test_a_budget_given_no_clock_reads_the_module_clock(monkeypatch: pytest.MonkeyPatch) -> None:
+    clock = StepClock(1.0)
+    monkeypatch.setattr(budget_mod, "CLOCK", clock)
+    det = HsvBlobDetector(vision=VisionConfig(budget_ms=2.0))
+    det.candidates(red_heavy())
+    assert det.cut_short and clock.reads > 0
