@@ -95,6 +95,19 @@ def frame_text(frame: bytes) -> str:
     return "".join(chr(b) if 0x20 <= b < 0x7F else f"\\x{b:02x}" for b in frame)
 
 
+def regex_class(characters: str) -> str:
+    """The inside of a regular expression's [...] for a set of letters, digits and '_': runs become ranges."""
+    codes = sorted(set(map(ord, characters)))
+    assert all(chr(c).isalnum() or chr(c) == "_" for c in codes), characters
+    out, start = [], 0
+    for i in range(1, len(codes) + 1):
+        if i == len(codes) or codes[i] != codes[i - 1] + 1:
+            run = codes[start:i]
+            out.append(f"{chr(run[0])}-{chr(run[-1])}" if len(run) > 2 else "".join(map(chr, run)))
+            start = i
+    return "".join(out)
+
+
 def block_comment(text: str) -> str:
     """Text for a C or JSDoc block comment: a frame's codes may be `*` then `/` (the comment would end) or `/`
     then `*` (GCC's -Wcomment); each gets the backslash JSDoc uses, shown as is in C."""
@@ -124,6 +137,7 @@ ALL: dict[str, Callable[..., Any]] = {
     "frame_text": frame_text,
     "wrap": wrap,
     "block_comment": block_comment,
+    "regex_class": regex_class,
     "tojson": lambda v: json.dumps(v, sort_keys=True),
     "add_suffix": lambda text, suffix: f"{text}{suffix}",
 }

@@ -16,6 +16,7 @@ from .build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
 from .diff import contract
 from .model import Spec
 from .names import pascal
+from .ready import build_ready_vectors, ready_rule
 from .targets import TARGETS, Target, comment_style
 from .vectors import build_vectors
 from .widths import CTYPES
@@ -92,6 +93,8 @@ def render_all(spec: Spec) -> dict[str, bytes]:
     context = {
         "spec": spec,
         "vectors": build_vectors(spec),
+        "ready_vectors": build_ready_vectors(spec),
+        "ready_rule": ready_rule(),
         "ardupilot": ardupilot.parameters(spec),
         "header": header_lines(spec),
         "header_json": json.dumps(

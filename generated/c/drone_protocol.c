@@ -312,15 +312,43 @@ bool dp_is_state(uint8_t code) {
   }
 }
 
-static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
+/* The ready line's one rule (the spec's replies.ready): after the prefix, exactly one space before each field;
+   the protocol, the fingerprint's hex digits and a known integrity mode; nothing else. */
+#define READY_SEPARATOR ' '
+static const char READY_PROTOCOL_CHARACTERS[] = "0123456789_abcdefghijklmnopqrstuvwxyz";
+static const char READY_FINGERPRINT_CHARACTERS[] = "0123456789abcdef";
+static const char *const READY_INTEGRITY_MODES[] = {"none", "crc8"};
 
-/* The next whitespace-separated word of text[*at..length), or a zero length. */
-static size_t word(const char *text, size_t length, size_t *at, const char **start) {
+/* The field after the separator at text[*at]: its length, or 0 (and *at unmoved) if no separator is there. */
+static size_t ready_field(const char *text, size_t length, size_t *at, const char **start) {
   size_t n = 0;
-  while (*at < length && is_space(text[*at])) ++*at;
-  *start = text + *at;
-  while (*at < length && !is_space(text[*at])) ++*at, ++n;
+  if (*at >= length || text[*at] != READY_SEPARATOR) return 0;
+  *start = text + ++*at;
+  while (*at < length && text[*at] != READY_SEPARATOR) ++*at, ++n;
   return n;
+}
+
+static bool all_in(const char *word, size_t length, const char *set) {
+  size_t i;
+  for (i = 0; i < length; ++i) {
+    if (word[i] == '\0' || strchr(set, word[i]) == NULL) return false;
+  }
+  return true;
+}
+
+static bool ready_fields_ok(const dp_reply *reply) {
+  size_t i;
+  if (reply->protocol_length < 1 || reply->protocol_length > 40 ||
+      !all_in(reply->protocol, reply->protocol_length, READY_PROTOCOL_CHARACTERS)) return false;
+  if (reply->fingerprint_length != 16 ||
+      !all_in(reply->fingerprint, reply->fingerprint_length, READY_FINGERPRINT_CHARACTERS)) return false;
+  for (i = 0; i < sizeof READY_INTEGRITY_MODES / sizeof READY_INTEGRITY_MODES[0]; ++i) {
+    const char *mode = READY_INTEGRITY_MODES[i];
+    if (strlen(mode) == reply->integrity_length && memcmp(mode, reply->integrity, reply->integrity_length) == 0) {
+      return true;
+    }
+  }
+  return false;
 }
 
 /* Reads the separator and status that end text[0..*length) and drops them from *length. */
@@ -340,7 +368,6 @@ static bool take_status(const char *text, size_t *length, dp_status *status) {
 dp_reply_status dp_parse_reply(const char *line, size_t length, dp_reply *reply) {
   size_t best = 0, prefix = 0, i, at = 0;
   const char *rest;
-  const char *extra;
   bool found = false;
   while (length > 0 && (line[length - 1] == '\n' || line[length - 1] == '\r')) --length;
   /* The longest matching prefix decides (the spec guarantees no prefix starts another). */
@@ -358,10 +385,10 @@ dp_reply_status dp_parse_reply(const char *line, size_t length, dp_reply *reply)
   rest = line + prefix;
   length -= prefix;
   if (reply->kind == DP_REPLY_READY) {
-    reply->protocol_length = word(rest, length, &at, &reply->protocol);
-    reply->fingerprint_length = word(rest, length, &at, &reply->fingerprint);
-    reply->integrity_length = word(rest, length, &at, &reply->integrity);
-    if (reply->integrity_length == 0 || word(rest, length, &at, &extra) != 0) return DP_REPLY_MALFORMED;
+    reply->protocol_length = ready_field(rest, length, &at, &reply->protocol);
+    reply->fingerprint_length = ready_field(rest, length, &at, &reply->fingerprint);
+    reply->integrity_length = ready_field(rest, length, &at, &reply->integrity);
+    if (at != length || !ready_fields_ok(reply)) return DP_REPLY_MALFORMED;
     return DP_REPLY_OK;
   }
   if (!take_status(rest, &length, &reply->status)) return DP_REPLY_MALFORMED;

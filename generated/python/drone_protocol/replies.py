@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from typing import Final, NamedTuple
 
@@ -54,6 +55,10 @@ STATUS_SEPARATOR: Final = " "
 _REPLY_PREFIXES: Final = tuple(sorted(ReplyKind, key=lambda k: -len(k.value)))
 _LASER: Final[Mapping[str, bool]] = {LASER_ON_CODE: True, LASER_OFF_CODE: False}
 _STATES: Final[Mapping[str, DroneState]] = {s.value: s for s in DroneState}
+# The ready line's one rule (the spec's replies.ready): after the prefix, exactly one space before each field;
+# the protocol, the fingerprint's hex digits and a known integrity mode; nothing else.
+_READY_RULE: Final = re.compile(
+    " ([0-9_a-z]{1,40}) ([0-9a-f]{16}) (none|crc8)")
 # Lines already parsed: a drone sends few distinct lines, and Reply is immutable.
 _PARSED: dict[bytes, Reply] = {}
 _PARSED_MAX: Final = 512
@@ -83,9 +88,9 @@ def _parse(body: bytes) -> Reply:
             continue
         rest = text[len(kind.value):]
         if kind is ReplyKind.READY:
-            parts = rest.split()
-            if len(parts) == 3:
-                return Reply(kind, protocol=parts[0], fingerprint=parts[1], integrity=parts[2])
+            ready = _READY_RULE.fullmatch(rest)
+            if ready is not None:
+                return Reply(kind, protocol=ready[1], fingerprint=ready[2], integrity=ready[3])
             raise ReplyError(f"malformed ready reply {text!r}: expected '{kind.value} <protocol> <fingerprint> "
                              "<integrity>'")
         rest, state, laser = _status(text, rest)

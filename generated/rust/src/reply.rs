@@ -204,12 +204,7 @@ pub fn parse_reply(line: &[u8]) -> Result<Reply<'_>, ReplyError> {
     let rest = &text[kind.prefix().len()..];
     let malformed = ReplyError::Malformed(kind);
     if let ReplyKind::Ready = kind {
-        let mut words = rest.split(|b| b.is_ascii_whitespace()).filter(|w| !w.is_empty());
-        let (Some(protocol), Some(fingerprint), Some(integrity), None) =
-            (words.next(), words.next(), words.next(), words.next())
-        else {
-            return Err(malformed);
-        };
+        let [protocol, fingerprint, integrity] = ready_fields(rest).ok_or(malformed)?;
         let text = |word| core::str::from_utf8(word).map_err(|_| malformed);
         return Ok(Reply::Ready {
             protocol: text(protocol)?,
@@ -234,6 +229,30 @@ pub fn parse_reply(line: &[u8]) -> Result<Reply<'_>, ReplyError> {
         (ReplyKind::Failsafe, []) => Ok(Reply::Failsafe { status }),
         _ => Err(malformed),
     }
+}
+
+// The ready line's one rule (the spec's replies.ready): after the prefix, exactly one space before each field;
+// the protocol, the fingerprint's hex digits and a known integrity mode; nothing else.
+const READY_SEPARATOR: u8 = b' ';
+const READY_PROTOCOL_CHARACTERS: &[u8] = "0123456789_abcdefghijklmnopqrstuvwxyz".as_bytes();
+const READY_PROTOCOL_MAX: usize = 40;
+const READY_FINGERPRINT_CHARACTERS: &[u8] = "0123456789abcdef".as_bytes();
+const READY_FINGERPRINT_LENGTH: usize = 16;
+const READY_INTEGRITY_MODES: [&str; 2] = ["none", "crc8"];
+
+/// The three fields of a ready line's `rest` (after its prefix), or None if it breaks the rule.
+fn ready_fields(rest: &[u8]) -> Option<[&[u8]; 3]> {
+    let mut words = rest.strip_prefix(&[READY_SEPARATOR])?.split(|b| *b == READY_SEPARATOR);
+    let fields = [words.next()?, words.next()?, words.next()?];
+    let [protocol, fingerprint, integrity] = fields;
+    let all_in = |word: &[u8], set: &[u8]| word.iter().all(|b| set.contains(b));
+    let ok = words.next().is_none()
+        && (1..=READY_PROTOCOL_MAX).contains(&protocol.len())
+        && all_in(protocol, READY_PROTOCOL_CHARACTERS)
+        && fingerprint.len() == READY_FINGERPRINT_LENGTH
+        && all_in(fingerprint, READY_FINGERPRINT_CHARACTERS)
+        && READY_INTEGRITY_MODES.iter().any(|mode| mode.as_bytes() == integrity);
+    ok.then_some(fields)
 }
 
 /// Builds one reply line in a caller's buffer.

@@ -24,10 +24,20 @@ fn field<'a>(line: &'a str, key: &str) -> Option<&'a str> {
     rest.find([',', '}']).map(|end| &rest[..end])
 }
 
-fn vectors() -> Vec<Vector> {
+/// vectors.json's path and text.
+fn vectors_file() -> (String, String) {
     let path = std::env::var("VECTORS_JSON")
         .unwrap_or_else(|_| concat!(env!("CARGO_MANIFEST_DIR"), "/../vectors.json").to_string());
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
+    (path, text)
+}
+
+fn hex_bytes(hex: &str) -> Vec<u8> {
+    (0..hex.len()).step_by(2).map(|i| u8::from_str_radix(&hex[i..i + 2], 16).unwrap()).collect()
+}
+
+fn vectors() -> Vec<Vector> {
+    let (path, text) = vectors_file();
     assert!(text.contains(SPEC_SHA256), "{path} is from another spec");
     let header = |key: &str| text.lines().find_map(|line| field(line, key)).map(str::to_string);
     assert_eq!(header("integrity").as_deref(), Some(INTEGRITY), "{path}: integrity mode");
@@ -38,7 +48,7 @@ fn vectors() -> Vec<Vector> {
         .map(|line| {
             let hex = field(line, "frame_hex").unwrap();
             Vector {
-                frame: (0..hex.len()).step_by(2).map(|i| u8::from_str_radix(&hex[i..i + 2], 16).unwrap()).collect(),
+                frame: hex_bytes(hex),
                 ok: field(line, "ok") == Some("true"),
                 command: field(line, "command").unwrap_or("").to_string(),
                 value: field(line, "value").map_or(0, |v| v.parse().unwrap()),
@@ -268,4 +278,32 @@ fn decode_never_panics_on_random_bytes() {
             assert_eq!(command.encode().unwrap().to_vec(), bytes);
         }
     }
+}
+
+#[test]
+fn ready_lines_follow_the_one_rule_of_the_spec() {
+    let (path, text) = vectors_file();
+    let mut checked = 0;
+    for line in text.lines().filter(|line| line.trim_start().starts_with("{\"ready_hex\"")) {
+        let bytes = hex_bytes(field(line, "ready_hex").unwrap());
+        let note = field(line, "note").unwrap();
+        let got = parse_reply(&bytes);
+        match field(line, "kind").unwrap() {
+            "ready" => assert_eq!(
+                got,
+                Ok(Reply::Ready {
+                    protocol: field(line, "protocol").unwrap(),
+                    fingerprint: field(line, "fingerprint").unwrap(),
+                    integrity: field(line, "integrity").unwrap(),
+                }),
+                "{note}"
+            ),
+            "malformed" => assert_eq!(got, Err(ReplyError::Malformed(ReplyKind::Ready)), "{note}"),
+            "unknown" => assert_eq!(got, Err(ReplyError::Unknown), "{note}"),
+            "bad_check" => assert_eq!(got, Err(ReplyError::BadCheck), "{note}"),
+            kind => panic!("{path}: unknown kind {kind}"),
+        }
+        checked += 1;
+    }
+    assert!(checked > 100, "too few ready lines in {path}");
 }

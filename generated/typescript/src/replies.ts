@@ -46,6 +46,10 @@ const BY_LETTER = new Map<string, ErrorName>(
   (Object.keys(ERRORS) as ErrorName[]).map((name) => [ERRORS[name].code, name]),
 );
 
+// The ready line's one rule (the spec's replies.ready): after the prefix, exactly one space before each field;
+// the protocol, the fingerprint's hex digits and a known integrity mode; nothing else.
+const READY_RULE = /^ ([0-9_a-z]{1,40}) ([0-9a-f]{16}) (none|crc8)$/;
+
 // Longest prefix first; the spec guarantees no prefix starts another.
 const PREFIXES = (Object.keys(REPLIES) as (keyof typeof REPLIES)[])
   .map((kind) => ({ kind, prefix: REPLIES[kind].prefix }))
@@ -71,9 +75,9 @@ export function parseReply(line: string | ArrayLike<number>): Reply {
     if (!text.startsWith(prefix)) continue;
     const rest = text.slice(prefix.length);
     if (kind === "ready") {
-      const parts = rest.split(/\s+/).filter((p) => p !== "");
-      if (parts.length === 3) {
-        return { kind, protocol: parts[0] ?? "", fingerprint: parts[1] ?? "", integrity: parts[2] ?? "" };
+      const ready = READY_RULE.exec(rest);
+      if (ready !== null) {
+        return { kind, protocol: ready[1] ?? "", fingerprint: ready[2] ?? "", integrity: ready[3] ?? "" };
       }
       throw new ProtocolError("bad_reply", `malformed ${kind} reply ${JSON.stringify(text)}`);
     }
