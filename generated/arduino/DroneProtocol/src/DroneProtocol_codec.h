@@ -108,14 +108,13 @@ class StreamParser {
   DRONE_PROTOCOL_ALWAYS_INLINE bool feed(uint8_t byte, uint32_t now_ms) {
     last_error_ = Error::None;
     uint8_t n = length_;
-    // The gap since the last byte, in 16 bits: exact below 65.536 s and cheaper than 32 on the AVR (a 32-bit
-    // clock wraps too, after 49.7 days); a longer silence has long set off the drone's failsafe. Bytes mostly
-    // arrive within the millisecond of the one before (11.5 per ms at 115200 baud back to back), when there is
-    // no gap to measure and nothing to store: one comparison.
-    const uint16_t now16 = static_cast<uint16_t>(now_ms);
-    if (now16 != last_ms_) {
-      if (n != 0 && static_cast<uint16_t>(now16 - last_ms_) > INTER_BYTE_TIMEOUT_MS) n = drop_stale();
-      last_ms_ = now16;
+    // The gap since the last byte, on the full 32-bit clock (unsigned: right across millis()'s wrap after 49.7
+    // days), so any silence longer than the timeout drops a partial frame, as in the other languages, with no
+    // call the sketch must remember. Bytes mostly arrive within the millisecond of the one before (11.5 per ms
+    // at 115200 baud back to back), when there is no gap to measure and nothing to store: one comparison.
+    if (now_ms != last_ms_) {
+      if (n != 0 && static_cast<uint32_t>(now_ms - last_ms_) > INTER_BYTE_TIMEOUT_MS) n = drop_stale();
+      last_ms_ = now_ms;
     }
     // The fast paths: a valid byte at its position (the checks of detail::step(), which the slow path uses),
     // each a few instructions; anything else goes to reject() (a slide never completes a frame).
@@ -161,9 +160,8 @@ class StreamParser {
   }
   // Bytes of a frame started but not complete.
   uint8_t pending() const { return length_; }
-  // Drops a partial frame (counted as a timeout) when the link has been silent: the firmware calls it when its
-  // failsafe fires, so a partial frame never waits long enough for feed()'s 16-bit gap to wrap (65.536 s) and
-  // be completed by bytes that arrive a minute later.
+  // Drops a partial frame now (counted as a timeout). Optional: feed() drops it anyway when the next byte comes
+  // after a silence longer than the timeout; the firmware calls it when its failsafe fires, to count it then.
   void expire() {
     if (length_ != 0) drop_stale();
   }
@@ -235,7 +233,7 @@ class StreamParser {
 
   uint8_t length_;
   Error last_error_;
-  uint16_t last_ms_;  // the low 16 bits of the clock at the last byte
+  uint32_t last_ms_;  // the clock at the last byte
   // The frame being read (see detail::step: `id` is the category index after byte 0; `value` is set when the
   // frame completes), and the last one complete once feed() returned true.
   Command command_;
