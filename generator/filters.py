@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import html
 import json
+import re
 import textwrap
 from collections.abc import Callable
 from typing import Any
@@ -85,6 +86,20 @@ def md_cell(text: str) -> str:
     return text.replace("|", "\\|")
 
 
+_MD_PUNCTUATION = re.compile(r"([\\`*_\[\]#|~])")
+_MD_LINE_START = re.compile(r"^(\d*)([-+=.)])")  # a list item, a setext underline or a thematic break
+
+
+def md_text(text: str) -> str:
+    """Spec text inert in a package README (CommonMark, as PyPI, crates.io, npm and GitHub render it): HTML's
+    & < > become entities, and every character Markdown reads as syntax (emphasis, links, images, code, headings,
+    tables, strikethrough; lists and rules at the start) gets a backslash, which CommonMark drops when it shows
+    the text. The text is one line (the reader joins a value's whitespace)."""
+    escaped = html.escape(text, quote=False)
+    escaped = _MD_PUNCTUATION.sub(r"\\\1", escaped)
+    return Safe(_MD_LINE_START.sub(r"\1\\\2", escaped))
+
+
 def md_code(text: str) -> str:
     """Inline Markdown code that survives backticks and surrounding spaces."""
     return Safe(f"`` {text} ``" if "`" in text or text != text.strip() else f"`{text}`")
@@ -132,6 +147,7 @@ ALL: dict[str, Callable[..., Any]] = {
     "check_hex": check_hex,
     "md_cell": md_cell,
     "md_code": md_code,
+    "md_text": md_text,
     "pascal": pascal,
     "upper": str.upper,
     "frame_text": frame_text,

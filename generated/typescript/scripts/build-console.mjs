@@ -37,7 +37,10 @@ for (const [i, part] of parts.entries()) {
 const page = readFileSync(join(root, "console.html"), "utf8");
 const main = /(<script type="module" id="console-main">\n)([\s\S]*?)(<\/script>)/.exec(page);
 if (main === null) throw new Error("console.html has no console-main script");
-const script = [...parts, strip("console.html", main[2] ?? "")].join("\n").replaceAll("</script", "<\\/script");
+// Inert inside the page's script: what would end it (</script) or switch the HTML parser into the states where
+// the real </script> no longer ends it (<!-- then <script), in any case, wherever it stands (spec text in a string,
+// a comment, a regular expression) becomes \x3C, which each of those reads as "<".
+const script = [...parts, strip("console.html", main[2] ?? "")].join("\n").replace(/<(?=!--|\/?script)/gi, "\\x3C");
 const bundled = page.slice(0, main.index) + (main[1] ?? "") + script + (main[3] ?? "") + page.slice(main.index + main[0].length);
 writeFileSync(join(root, "dist", "console.html"), bundled);
 console.log(`dist/console.html: ${bundled.length} bytes, ${MODULES.length} modules inlined`);
