@@ -134,6 +134,11 @@ def wrap(text: str, width: int = 100, prefix: str = "") -> str:
     return textwrap.fill(text, width=width, subsequent_indent=prefix, break_on_hyphens=False)
 
 
+def one_in(p: float) -> str:
+    """A small probability as "1 in N" (N rounded to 3 significant digits), or "never"."""
+    return "never" if p == 0 else f"1 in {float(f'{1 / p:.3g}'):,.0f}"
+
+
 ALL: dict[str, Callable[..., Any]] = {
     "cpp_char": cpp_char,
     "cpp_string": cpp_string,
@@ -148,6 +153,7 @@ ALL: dict[str, Callable[..., Any]] = {
     "md_cell": md_cell,
     "md_code": md_code,
     "md_text": md_text,
+    "one_in": one_in,
     "pascal": pascal,
     "upper": str.upper,
     "frame_text": frame_text,

@@ -17,7 +17,7 @@ from .diff import contract
 from .model import Spec
 from .names import pascal
 from .ready import build_ready_vectors, ready_rule
-from .safety import one_byte_neighbours, safe_defaults
+from .safety import form_figures, one_byte_neighbours, safe_defaults
 from .targets import TARGETS, Target, comment_style
 from .vectors import build_vectors
 from .widths import CTYPES
@@ -98,6 +98,7 @@ def render_all(spec: Spec) -> dict[str, bytes]:
         "ready_rule": ready_rule(),
         "one_byte_neighbours": one_byte_neighbours(spec),
         "safe_defaults": safe_defaults(spec),
+        "form_figures": form_figures(spec, 0.01),
         "ardupilot": ardupilot.parameters(spec),
         "header": header_lines(spec),
         "header_json": json.dumps(

@@ -8,9 +8,10 @@ check (CRC-8 detects every single-byte error), so none can pass as the other."""
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
-from .model import Command, Spec
+from .model import Command, Spec, check_text
 
 # What a command does to safety; a command without `safety:` is routine (moves, turns, servos, holding).
 SAFETY_EFFECTS = ("arm", "disarm", "land", "laser_on", "laser_off", "laser_toggle", "self_test")
@@ -103,4 +104,50 @@ def safe_defaults(spec: Spec) -> list[tuple[Command, str]]:
         frame = d.frame(c.category.code, d.default_frame_value)
         if d.command in exposed and d.default is not None and free_of_neighbours(spec, frame):
             out.append((c, frame))
+    return out
+
+
+@functools.lru_cache(maxsize=4)
+def _targets(spec: Spec, crc8: bool) -> tuple[tuple[bytes, int, str], ...]:
+    """Every valid frame of the spec on the wire (with its check in crc8 mode), its command's index and effect."""
+    table = [int(check_text(bytes([b])), 16) for b in range(256)]
+    out = []
+    for c in spec.commands:
+        d = c.direction
+        for value in range(d.minimum, d.maximum + 1):
+            frame = d.frame(c.category.code, value).encode()
+            crc = 0
+            for byte in frame:
+                crc = table[crc ^ byte]
+            out.append((frame + b"%02X" % crc if crc8 else frame, c.index, d.safety or ROUTINE))
+    return tuple(out)
+
+
+def substitution_rates(spec: Spec, frame: bytes, crc8: bool, q: float) -> tuple[float, float]:
+    """Exact probabilities that `frame`, each of its wire bytes replaced with probability q by one of the 255
+    others, arrives as another valid command, and as one with another safety effect: the sum, over every valid
+    wire frame of another command at Hamming distance d, of q^d (1-q)^(n-d) / 255^d."""
+    targets = _targets(spec, crc8)
+    sent, index, effect = next(t for t in targets if t[0][:len(frame)] == frame)
+    n = len(sent)
+    other = hazard = 0.0
+    for target, target_index, target_effect in targets:
+        if target_index != index:
+            k = sum(a != b for a, b in zip(sent, target, strict=True))
+            p = q ** k * (1 - q) ** (n - k) / 255 ** k
+            other += p
+            hazard += p * (target_effect != effect)
+    return other, hazard
+
+
+def form_figures(spec: Spec, q: float) -> list[tuple[Command, str, str, float, float, float]]:
+    """For each command of safe_defaults: its other form's frame and its default frame, and the chance at `q`
+    that they arrive with another safety effect: the other form with no check, the default with no check and
+    with crc8. What the docs print (the bench prints more)."""
+    out = []
+    for c, frame in safe_defaults(spec):
+        other = c.direction.frame(c.category.code, c.direction.minimum)
+        out.append((c, other, frame, substitution_rates(spec, other.encode(), False, q)[1],
+                    substitution_rates(spec, frame.encode(), False, q)[1],
+                    substitution_rates(spec, frame.encode(), True, q)[1]))
     return out

@@ -6,13 +6,14 @@ from __future__ import annotations
 
 import contextlib
 import json
+import shutil
 from pathlib import Path
 
 import drone_protocol as dp
 import protocol_harness as h
 
 from generator.build import load_spec
-from generator.safety import ROUTINE, free_of_neighbours, one_byte_neighbours
+from generator.safety import ROUTINE, free_of_neighbours, one_byte_neighbours, substitution_rates
 
 SPEC = h.ROOT / "spec" / "drone.yaml"
 EFFECTS = {c.direction.command: c.direction.safety or ROUTINE for c in load_spec(SPEC).commands}
@@ -88,3 +89,26 @@ def test_an_unknown_safety_effect_is_one_clear_error(tmp_path: Path) -> None:
     run = h.generate("--spec", tmp_path / "drone.yaml", "--out", tmp_path / "out")
     assert run.code == 2 and "unknown safety effect 'lands'" in run.stderr and "did you mean 'land'?" in run.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_a_spec_without_an_integrity_mode_gets_crc8_and_an_old_output_stops_it(tmp_path: Path) -> None:
+    """crc8 is the default of new specs (bench/lossy/RESULTS.md); a spec that relied on the old default (none)
+    is not moved to crc8 unnoticed over its earlier output: the breaking-change check names the mode."""
+    text = h.edit(SPEC.read_text(encoding="utf-8"), "  integrity: none\n", "")
+    (tmp_path / "drone.yaml").write_text(text, encoding="utf-8")
+    assert h.generate("--spec", tmp_path / "drone.yaml", "--out", tmp_path / "new").code == 0
+    assert '"integrity": "crc8"' in (tmp_path / "new" / "vectors.json").read_text(encoding="utf-8")
+    shutil.copytree(h.ROOT / "generated", tmp_path / "old")
+    run = h.generate("--spec", tmp_path / "drone.yaml", "--out", tmp_path / "old")
+    assert run.code == 2 and "frame.integrity: 'none' -> 'crc8'" in run.stderr
+
+
+def test_the_exact_substitution_rate_matches_its_first_order_term() -> None:
+    """is0000's four one-byte neighbours (arm, disarm, first_test, land) dominate its chance, at 1 % per byte, of
+    arriving with another safety effect: 4 q (1-q)^5 / 255, plus two-byte terms ~1000 times smaller."""
+    spec, q = load_spec(SPEC), 0.01
+    first_order = 4 * q * (1 - q) ** 5 / 255
+    other, hazard = substitution_rates(spec, b"is0000", False, q)
+    assert first_order <= hazard < first_order * 1.01 and other >= hazard
+    assert substitution_rates(spec, dp.hold_altitude(), False, q)[1] < first_order / 10_000
+    assert substitution_rates(spec, dp.hold_altitude(), True, q)[1] < substitution_rates(spec, b"is0000", True, q)[1]
