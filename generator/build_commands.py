@@ -9,6 +9,7 @@ from .errors import SpecError
 from .model import Category, Channel, Direction, Field, Servo
 from .names import identifier_problem
 from .reader import Reader, is_code
+from .safety import SAFETY_EFFECTS
 from .source import Node
 
 T = TypeVar("T")
@@ -112,6 +113,11 @@ class CommandsBuilder:
         servo_name = r.get("servo", str, required=False)
         sense = r.get("sense", int, required=False)
         routine = r.text("routine", "")
+        safety = r.text("safety", "")
+        if safety and safety not in SAFETY_EFFECTS:
+            near = difflib.get_close_matches(safety, SAFETY_EFFECTS, n=1)
+            r.error(r.node.children["safety"], f"unknown safety effect '{safety}'",
+                    f"did you mean '{near[0]}'?" if near else "known: " + ", ".join(SAFETY_EFFECTS), r.sub("safety"))
         default_node = r.node.children.get("default")
         r.seen.add("default")
         r.finish()
@@ -177,4 +183,4 @@ class CommandsBuilder:
                     r.sub("name"))
             return None
         return Direction(dcode, name, command, description, fld, pair[0], pair[1], default, label, target,
-                         sense or 0, routine, filler_code is not None)
+                         sense or 0, routine, filler_code is not None, safety if safety in SAFETY_EFFECTS else "")

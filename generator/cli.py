@@ -63,9 +63,12 @@ def main(argv: list[str] | None = None) -> int:
               f"fingerprint {spec.short_fingerprint})")
         return 0
     from .render import render_all, stale_files, write_atomically  # Jinja only for a valid spec
+    from .safety import report as safety_report
 
     files = render_all(spec)
     if opts.check:
+        for line in safety_report(spec):
+            print(line)
         problems = stale_files(files, opts.out)
         for line in problems:
             print(line)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import html
 import json
+import re
 import textwrap
 from collections.abc import Callable
 from typing import Any
@@ -85,6 +86,20 @@ def md_cell(text: str) -> str:
     return text.replace("|", "\\|")
 
 
+_MD_PUNCTUATION = re.compile(r"([\\`*_\[\]#|~])")
+_MD_LINE_START = re.compile(r"^(\d*)([-+=.)])")  # a list item, a setext underline or a thematic break
+
+
+def md_text(text: str) -> str:
+    """Spec text inert in a package README (CommonMark, as PyPI, crates.io, npm and GitHub render it): HTML's
+    & < > become entities, and every character Markdown reads as syntax (emphasis, links, images, code, headings,
+    tables, strikethrough; lists and rules at the start) gets a backslash, which CommonMark drops when it shows
+    the text. The text is one line (the reader joins a value's whitespace)."""
+    escaped = html.escape(text, quote=False)
+    escaped = _MD_PUNCTUATION.sub(r"\\\1", escaped)
+    return Safe(_MD_LINE_START.sub(r"\1\\\2", escaped))
+
+
 def md_code(text: str) -> str:
     """Inline Markdown code that survives backticks and surrounding spaces."""
     return Safe(f"`` {text} ``" if "`" in text or text != text.strip() else f"`{text}`")
@@ -93,6 +108,19 @@ def md_code(text: str) -> str:
 def frame_text(frame: bytes) -> str:
     """A frame for prose: printable ASCII as is, anything else as \\xNN."""
     return "".join(chr(b) if 0x20 <= b < 0x7F else f"\\x{b:02x}" for b in frame)
+
+
+def regex_class(characters: str) -> str:
+    """The inside of a regular expression's [...] for a set of letters, digits and '_': runs become ranges."""
+    codes = sorted(set(map(ord, characters)))
+    assert all(chr(c).isalnum() or chr(c) == "_" for c in codes), characters
+    out, start = [], 0
+    for i in range(1, len(codes) + 1):
+        if i == len(codes) or codes[i] != codes[i - 1] + 1:
+            run = codes[start:i]
+            out.append(f"{chr(run[0])}-{chr(run[-1])}" if len(run) > 2 else "".join(map(chr, run)))
+            start = i
+    return "".join(out)
 
 
 def block_comment(text: str) -> str:
@@ -104,6 +132,11 @@ def block_comment(text: str) -> str:
 def wrap(text: str, width: int = 100, prefix: str = "") -> str:
     """Text wrapped to `width` columns, every line after the first starting with `prefix`."""
     return textwrap.fill(text, width=width, subsequent_indent=prefix, break_on_hyphens=False)
+
+
+def one_in(p: float) -> str:
+    """A small probability as "1 in N" (N rounded to 3 significant digits), or "never"."""
+    return "never" if p == 0 else f"1 in {float(f'{1 / p:.3g}'):,.0f}"
 
 
 ALL: dict[str, Callable[..., Any]] = {
@@ -119,11 +152,14 @@ ALL: dict[str, Callable[..., Any]] = {
     "check_hex": check_hex,
     "md_cell": md_cell,
     "md_code": md_code,
+    "md_text": md_text,
+    "one_in": one_in,
     "pascal": pascal,
     "upper": str.upper,
     "frame_text": frame_text,
     "wrap": wrap,
     "block_comment": block_comment,
+    "regex_class": regex_class,
     "tojson": lambda v: json.dumps(v, sort_keys=True),
     "add_suffix": lambda text, suffix: f"{text}{suffix}",
 }

@@ -54,6 +54,7 @@ class Direction:
     sense: int  # +1 / -1 for servo moves, 0 otherwise
     routine: str  # the seed's firmware routine for `i` commands, else ""
     filler: bool  # the direction byte is a filler (laser), not a direction
+    safety: str = ""  # what the command does to safety (generator/safety.py SAFETY_EFFECTS); "" for routine
 
     def frame(self, category: str, value: int) -> str:
         return f"{category}{self.code}{value:0{self.field.width}d}"

@@ -16,6 +16,8 @@ from .build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
 from .diff import contract
 from .model import Spec
 from .names import pascal
+from .ready import build_ready_vectors, ready_rule
+from .safety import form_figures, one_byte_neighbours, safe_defaults
 from .targets import TARGETS, Target, comment_style
 from .vectors import build_vectors
 from .widths import CTYPES
@@ -98,6 +100,11 @@ def render_all(spec: Spec) -> dict[str, bytes]:
         "ardupilot": ardupilot.pilot_parameters(parameter_files),
         "wiring_rows": diagram.wires(spec),
         "svg_height": diagram.height(spec),
+        "ready_vectors": build_ready_vectors(spec),
+        "ready_rule": ready_rule(),
+        "one_byte_neighbours": one_byte_neighbours(spec),
+        "safe_defaults": safe_defaults(spec),
+        "form_figures": form_figures(spec, 0.01),
         "header": header_lines(spec),
         "header_json": json.dumps(
             {"notice": header_lines(spec)[0], "fingerprint": spec.fingerprint, "spec": spec.source_name,

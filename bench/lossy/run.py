@@ -34,6 +34,7 @@ from typing import Any
 import drone_protocol as dp
 
 from bench.lossy.proxy import LossyProxy
+from bench.lossy.substitution import BEGIN as SUBSTITUTION
 from pilot.app.runner import run
 from pilot.common.config import PilotConfig
 from pilot.control.controller import Controller
@@ -47,6 +48,7 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
 RATES = (0.0, 0.01, 0.02, 0.10)
 DISAGREE_LIMIT_MS = 200
+
 
 
 @dataclass
@@ -290,7 +292,10 @@ def main() -> None:
     worst = [(r.integrity, r.rate, r.scenario, r.seed, r.reason) for r in rows if not r.completed]
     print("not completed:", worst)
     if not args.no_write:
-        (HERE / "RESULTS.md").write_text(text, encoding="utf-8")
+        results = HERE / "RESULTS.md"
+        old = results.read_text(encoding="utf-8") if results.exists() else ""
+        kept = old[old.find(SUBSTITUTION):] if SUBSTITUTION in old else ""  # substitution.py's section
+        results.write_text(text + ("\n" + kept if kept else ""), encoding="utf-8")
 
 
 if __name__ == "__main__":

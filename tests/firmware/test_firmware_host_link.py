@@ -92,8 +92,8 @@ def test_a_frame_split_by_a_long_pause_is_dropped() -> None:
     assert all(c["pitch"] == fw.neutral()["pitch"] for c in trace.changes if c["t_ms"] >= t0)
 
 
-def test_a_partial_frame_does_not_survive_a_silence_that_wraps_the_parsers_16_bit_gap() -> None:
-    """feed() measures the gap in 16 bits; the failsafe drops the partial frame long before 65.536 s pass."""
+def test_a_partial_frame_does_not_survive_a_silence_of_65536_ms() -> None:
+    """A silence of 2^16 ms (where a 16-bit gap would read 0): the partial frame is dropped, not completed."""
     frame = dp.arm()
     script = fw.Script()
     script.step(dp.FAILSAFE_TIMEOUT_MS + 10)  # boot's failsafe is over: the next valid frame is honoured

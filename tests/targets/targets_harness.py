@@ -68,7 +68,7 @@ def c_driver() -> Path:
 @functools.cache
 def cpp_driver() -> Path:
     source = DRIVERS / "stream_driver.cpp"
-    key = _digest(source, CPP_DIR / "DroneProtocol.h", *CXXFLAGS)
+    key = _digest(source, *sorted(CPP_DIR.iterdir()), *CXXFLAGS)
     return _cached("stream_driver_cpp", key, lambda out: [
         "g++", *CXXFLAGS, f"-I{CPP_DIR}", str(source), "-o", str(out)])
 

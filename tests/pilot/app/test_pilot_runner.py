@@ -56,4 +56,4 @@ def test_status_line_off_a_terminal_prints_one_line_per_state() -> None:
     lines = out.getvalue().splitlines()
     assert len(lines) == 2
     assert "state search" in lines[0] and "state track" in lines[1]
-    assert "target yes" in lines[1] and "20 cmd/s" in lines[1] and "last is0000" in lines[1]
+    assert "target yes" in lines[1] and "20 cmd/s" in lines[1] and f"last {dp.hold_altitude().decode()}" in lines[1]

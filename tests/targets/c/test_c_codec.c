@@ -78,6 +78,44 @@ static void check_vector(const char *line) {
   }
 }
 
+static size_t ready_lines = 0;
+
+/* One ready_lines entry of vectors.json: the line parses as the kind the spec's rule gives it. */
+static void check_ready_line(const char *json) {
+  char hex[512], kind[16], note[128], protocol[64], fingerprint[64], integrity[16];
+  char line[256];
+  size_t n = 0, i;
+  dp_reply reply;
+  dp_reply_status got;
+  if (!field(json, "ready_hex", hex, sizeof hex) || !field(json, "kind", kind, sizeof kind)) return;
+  field(json, "note", note, sizeof note);
+  for (i = 0; hex[i] != '\0' && hex[i + 1] != '\0' && n < sizeof line; i += 2) {
+    unsigned byte;
+    sscanf(hex + i, "%2x", &byte);
+    line[n++] = (char)byte;
+  }
+  got = dp_parse_reply(line, n, &reply);
+  ++ready_lines;
+  if (strcmp(kind, "ready") == 0) {
+    field(json, "protocol", protocol, sizeof protocol);
+    field(json, "fingerprint", fingerprint, sizeof fingerprint);
+    field(json, "integrity", integrity, sizeof integrity);
+    CHECK(got == DP_REPLY_OK && reply.kind == DP_REPLY_READY, "%s: refused", note);
+    if (got != DP_REPLY_OK) return;
+    CHECK(reply.protocol_length == strlen(protocol) && memcmp(reply.protocol, protocol, reply.protocol_length) == 0 &&
+              reply.fingerprint_length == strlen(fingerprint) &&
+              memcmp(reply.fingerprint, fingerprint, reply.fingerprint_length) == 0 &&
+              reply.integrity_length == strlen(integrity) && memcmp(reply.integrity, integrity, reply.integrity_length) == 0,
+          "%s: fields", note);
+  } else if (strcmp(kind, "malformed") == 0) {
+    CHECK(got == DP_REPLY_MALFORMED && reply.kind == DP_REPLY_READY, "%s: got %d", note, (int)got);
+  } else if (strcmp(kind, "unknown") == 0) {
+    CHECK(got == DP_REPLY_UNKNOWN, "%s: got %d", note, (int)got);
+  } else {
+    CHECK(strcmp(kind, "bad_check") == 0 && got == DP_REPLY_BAD_CHECK, "%s: %s, got %d", note, kind, (int)got);
+  }
+}
+
 static void check_replies(void) {
   char line[DP_REPLY_MAX_LENGTH];
   dp_reply reply;
@@ -194,8 +232,9 @@ int main(int argc, char **argv) {
   }
   while (fgets(line, sizeof line, file) != NULL) {
     char text[32];
-    if (strstr(line, "\"fingerprint\"") != NULL) CHECK(strstr(line, DP_SPEC_SHA256) != NULL, "vectors of another spec");
-    if (strstr(line, "\"frame_hex\"") == NULL && field(line, "integrity", text, sizeof text)) {
+    if (strstr(line, "\"fingerprint\"") != NULL && strstr(line, "\"ready_hex\"") == NULL) CHECK(strstr(line, DP_SPEC_SHA256) != NULL, "vectors of another spec");
+    if (strstr(line, "\"frame_hex\"") == NULL && strstr(line, "\"ready_hex\"") == NULL &&
+        field(line, "integrity", text, sizeof text)) {
       CHECK(strcmp(text, DP_INTEGRITY) == 0, "vectors of integrity mode %s", text);
       ++headers;
     }
@@ -207,10 +246,12 @@ int main(int argc, char **argv) {
       check_vector(line);
       ++vectors;
     }
+    if (strstr(line, "\"ready_hex\"") != NULL) check_ready_line(line);
   }
   fclose(file);
   CHECK(vectors > 50 && valid_count > 20, "too few vectors (%zu)", vectors);
   CHECK(headers == 2, "vectors.json names its integrity mode and wire length");
+  CHECK(ready_lines > 100, "too few ready lines (%zu)", ready_lines);
   check_replies();
   if (valid_count > 0) check_stream();
   if (failures == 0) printf("C codec: %zu vectors, replies and a 200000-byte stream agree\n", vectors);

@@ -3,7 +3,7 @@ import assert from "node:assert/strict";
 import { execFileSync } from "node:child_process";
 import { join } from "node:path";
 import { test } from "node:test";
-import { PYTHON, TOOLS, VECTORS, ascii, dp, fromHex, rng, toHex } from "./support.mjs";
+import { PYTHON, READY_LINES, TOOLS, VECTORS, ascii, dp, fromHex, rng, toHex } from "./support.mjs";
 
 const reference = (mode, input = "") =>
   execFileSync(PYTHON, [join(TOOLS, "python_reference.py"), mode], { input, encoding: "utf8", maxBuffer: 1 << 28 });
@@ -108,6 +108,24 @@ test("parseReply() reads every line the writers write, with every status, and re
   ];
   for (const line of bad) {
     assert.throws(() => dp.parseReply(line), (e) => e instanceof dp.ProtocolError && ["bad_reply", "bad_check"].includes(e.code), line);
+  }
+});
+
+test("parseReply() judges every odd ready line of vectors.json as the spec's one rule does", () => {
+  assert.ok(READY_LINES.length > 100, `${READY_LINES.length} ready lines`);
+  for (const v of READY_LINES) {
+    const line = fromHex(v.ready_hex);
+    if (v.kind === "ready") {
+      assert.deepEqual(dp.parseReply(line),
+        { kind: "ready", protocol: v.protocol, fingerprint: v.fingerprint, integrity: v.integrity }, v.note);
+      continue;
+    }
+    assert.throws(() => dp.parseReply(line), (e) => {
+      assert.ok(e instanceof dp.ProtocolError, v.note);
+      assert.equal(e.code, v.kind === "bad_check" ? "bad_check" : "bad_reply", v.note);
+      assert.match(e.message, v.kind === "unknown" ? /^unknown reply/ : /^(malformed ready reply|reply .* has no valid check)/, v.note);
+      return true;
+    });
   }
 });
 
