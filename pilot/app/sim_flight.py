@@ -172,7 +172,8 @@ def fly(
     if detector_name is not None:
         cfg = dataclasses.replace(cfg, detector=detector_name)
     scenario = make_scenario(scenario_name, seed, noise=noise, max_wind=max_wind, gusts=gusts, ideal=ideal)
-    detector = make_detector(cfg)
+    # a flight is deterministic for its seed: the detector's budget counts simulated time, in which a look takes none
+    detector = make_detector(cfg, clock=lambda: 0.0)
     recorder = Recorder(record_dir, fps=cfg.link.rate_hz) if record_dir is not None else None
     wall0 = time.perf_counter()
     tick_ms = round(1000.0 / cfg.link.rate_hz)

@@ -18,7 +18,8 @@ blur and at the frame's edge, zero false positives, and a cost near OpenCV's def
 * A second look at half resolution when the full frame has no marker: motion blur halves with the image
   and the look costs a quarter of the first.
 * A third, while the frame's budget (``vision.budget_ms``) lasts: a marker with one corner covered
-  (aruco_corner.py), which OpenCV's quadrilaterals miss; scored ``CORNER_SCORE``.
+  (aruco_corner.py), which OpenCV's quadrilaterals miss; scored ``CORNER_SCORE``. A tracked marker gets that look
+  in a window where the track expects it whatever the budget (``candidates_near``).
 Every marker of the configured id is a candidate; its size must imply a plausible range.
 """
 
@@ -140,5 +141,16 @@ class ArucoMarkerDetector:
         return None
 
     def candidates_near(self, image: MatLike, cx: float, cy: float, size: float) -> list[Candidate]:
-        """None: a marker's cells are read whole or not at all, and the frame's look read them already."""
-        return []
+        """A tracked marker the frame's look missed: the covered-corner look in a window twice its size where the
+        track expects it, whatever the budget (a window costs a fraction of a frame's look)."""
+        if malformed(image) is not None or self.marker_id < 0:
+            return []
+        w, h = frame_size(image)
+        x0, y0 = max(0, int(cx - size)), max(0, int(cy - size))
+        x1, y1 = min(w, int(cx + size) + 1), min(h, int(cy + size) + 1)
+        if min(x1 - x0, y1 - y0) < CORNER_MIN_SIDE:
+            return []
+        grey = cv2.cvtColor(np.ascontiguousarray(image[y0:y1, x0:x1]), cv2.COLOR_BGR2GRAY)
+        offset = np.array((x0, y0), np.float64)
+        quads = [q + offset for q in corner_covered_markers(grey, self._references, CORNER_MIN_SIDE)]
+        return self._placed(quads, 1.0, w, CORNER_SCORE)

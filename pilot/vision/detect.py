@@ -14,6 +14,8 @@ The pipeline (each part in its own module):
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from cv2.typing import MatLike
 
 from ..common.config import PilotConfig, VisionConfig
@@ -76,14 +78,15 @@ class TrackedDetector:
                          aim_on_target=aim, cut_short=cut)
 
 
-def make_detector(config: PilotConfig) -> TrackedDetector:
+def make_detector(config: PilotConfig, clock: Callable[[], float] | None = None) -> TrackedDetector:
+    """``clock``: seconds, for the frame's budget (default ``pilot.vision.budget.CLOCK``, the wall clock)."""
     fov = config.controller.horizontal_fov_deg
     source: CandidateSource
     if config.detector == "hsv":
         ball = SimpleBallDetector if config.hsv.simple else HsvBlobDetector
-        source, size = ball(config.hsv, config.vision, fov), config.hsv.target_diameter_m
+        source, size = ball(config.hsv, config.vision, fov, clock), config.hsv.target_diameter_m
     elif config.detector == "aruco":
-        source, size = ArucoMarkerDetector(config.aruco, config.vision, fov), config.aruco.marker_size_m
+        source, size = ArucoMarkerDetector(config.aruco, config.vision, fov, clock), config.aruco.marker_size_m
     else:
         raise ConfigError(f"option 'detector' must be 'hsv' or 'aruco', got {config.detector!r}")
     return TrackedDetector(source, size, fov, config.vision, config.controller.acquire_confidence)

@@ -76,3 +76,27 @@ def test_a_pentagon_gives_back_its_cut_corner() -> None:
     cut = np.array([[30, 0], [100, 0], [100, 100], [0, 100], [0, 30]], np.float64)  # the corner at (0, 0) cut
     quads = cut_corner_quads(cut)
     assert any(np.allclose(np.sort(q, axis=0), np.sort(square, axis=0)) for q in quads)
+
+
+def test_a_tracked_marker_whose_corner_gets_covered_stays_tracked_whatever_the_budget() -> None:
+    from pilot.vision.detect import TrackedDetector
+
+    img, cx, cy = covered(7, 60, 3)
+    whole = img.copy()
+    clean_img = np.full((240, 320, 3), 150, np.uint8)
+    rng = np.random.default_rng(3)
+    centre = vi.marker(clean_img, 160.0 + rng.uniform(-40, 40), 120.0 + rng.uniform(-30, 30), 70.0, rng).mean(axis=0)
+    assert abs(centre[0] - cx) < 1e-6 and abs(centre[1] - cy) < 1e-6  # the same marker, uncovered
+    t = [0.0]
+
+    def clock() -> float:
+        t[0] += 0.004  # every frame's budget (2 ms) is spent before the frame's own covered-corner look
+        return t[0]
+
+    source = ArucoMarkerDetector(ArucoConfig(marker_id=7), VisionConfig(budget_ms=2.0), clock=clock)
+    det = TrackedDetector(source, 0.3, 60.0, VisionConfig(budget_ms=2.0))
+    for _ in range(3):
+        assert det.detect(clean_img + np.uint8(_)).found  # tracked on the whole marker (frames differ: not frozen)
+    covered_now = det.detect(whole)
+    assert covered_now.found and not covered_now.predicted and covered_now.confidence == CORNER_SCORE
+    assert math.hypot(covered_now.cx - cx, covered_now.cy - cy) < 4.0

@@ -104,3 +104,14 @@ def test_a_budget_given_no_clock_reads_the_module_clock(monkeypatch: pytest.Monk
     det = HsvBlobDetector(vision=VisionConfig(budget_ms=2.0))
     det.candidates(red_heavy())
     assert det.cut_short and clock.reads > 0
+
+
+def test_make_detector_passes_its_clock_to_either_detector() -> None:
+    from pilot.vision.aruco import ArucoMarkerDetector
+    from pilot.vision.detect import make_detector
+
+    clock = StepClock(0.0)
+    hsv = make_detector(PilotConfig(), clock=clock).source
+    aruco = make_detector(PilotConfig(detector="aruco"), clock=clock).source
+    assert isinstance(hsv, HsvBlobDetector) and hsv.budget.clock is clock
+    assert isinstance(aruco, ArucoMarkerDetector) and aruco.budget.clock is clock

@@ -149,3 +149,15 @@ def test_a_short_video_of_the_ball_is_read_frame_by_frame(tmp_path: Path) -> Non
     assert len(read_frames(video, (320, 240))) == 4  # every other frame of the eight
     with pytest.raises(ConfigError, match=r"ball\.avi.*320x240"):
         read_frames(video, (640, 480))
+
+
+def test_the_pilot_refuses_to_start_on_a_corrupt_model_in_one_line(tmp_path: Path) -> None:
+    model = tmp_path / "pilot.colour.npz"
+    model.write_bytes(b"garbage")
+    (tmp_path / "pilot.yaml").write_text(f"hsv:\n  colour_model: {model}\n")
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    frames(folder, "f", [room(s) for s in range(2)])
+    code, out, err = call("--config", str(tmp_path / "pilot.yaml"), "--images", str(folder), "--dry-run",
+                          "--no-status")
+    assert code == 2 and str(model) in err and len(err.strip().splitlines()) == 1 and "dry-run" not in out
