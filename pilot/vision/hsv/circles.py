@@ -1,37 +1,10 @@
 """The circle look of the colour-ball detector (detector.py): balls the mask cannot separate at all, found by their
 rim in the image's brightness or colour.
 
-A ball lying on a surface of its own colour (a red saucer, a red motorbike's tank) is one blob with it, and edges
-cut it into pieces too: its shading (the terminator, the highlight) is an edge inside it as strong as its rim. Its
-rim is still a circle of brightness edges whose gradients point along the radius. Here the window's edge pixels
-near the mask vote, along their gradient both ways, for the centre of a circle of each radius they might lie on
-(a Hough transform for circles); the best centres of each octave of radii are checked for the target's colour
-inside, and for rim support (rim.py, in brightness or in colour), which also refines the circle.
-
-The edges vote twice: in brightness, then in colour (each pixel's strongest channel, as OpenCV's Canny takes a
-colour image). A red ball's rim is often a larger step in one channel than in grey, which weighs red at 0.3: blur
-takes the grey step under Canny's thresholds first. Of the balls the colour votes found on the dev seeds, most
-stepped 1.2-3 times as much in red (or green) as in grey across their rim. A circle voted for in colour counts
-from ``hsv_rim.COLOUR_FROM`` across, as a colour rim does. On the five dev seed sets of bench/vision (18,000 views,
-not the report's): 24 balls more (motion blur 7, Gaussian blur 4, warm light 5), none fewer, the same false
-detections; without the size bound, 28 more and 2 false detections more (circles of 16-17 px). It doubles the
-circle look's cost (1.2 -> 2.2 ms a window on those views), in frames where nothing else scored.
-
-A window with no circle whose rim is whole (``WHOLE``) takes its circles from ``COLOUR_FROM`` across with a rim of
-``DOMED_RIM`` whose middle is lit as a ball's (dome.py): JPEG's blocks, or a dark ground behind a ball's
-shaded side, leave parts of its rim with no edge, while a ball lit from the camera's side is brighter in its middle
-than near its limb, and a flat red thing or a cup is not. On the dev seed sets of bench/vision (not the report's),
-chosen on the tuning photos' sets (6,099 balls from 16 px; 9,750 empty, distractor and red-shape views):
-
-  | rim from | middle over limb | balls (tuning sets) | false detections (tuning sets) |
-  |---|---|---|---|
-  | 0.7 | 0.1 | +7 | the same |
-  | 0.65 | 0.15 | +11 | +1 |
-  | 0.65 | 0.1 | +16 | +4 |
-
-then on the validation photos' sets with 0.7 and 0.1: +5 balls of 4,039, a red shape more in 6,000 views. In all,
-12 balls more of 10,138, none fewer (7 of them JPEG), and one false detection more in 15,750 views with no ball.
-"""
+A ball on a surface of its own colour is one blob with it, and its shading cuts it into pieces too; its rim is still
+a circle of edges whose gradients point along the radius. Edge pixels near the mask vote for circle centres (a
+Hough transform), in brightness then in colour; the best centre of each octave of radii is checked for the target's
+colour inside and for rim support (``rim.py``). Figures: bench/vision/HISTORY.md."""
 
 from __future__ import annotations
 

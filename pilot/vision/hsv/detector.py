@@ -1,94 +1,13 @@
 """The colour-ball detector: every blob of the target's colour, scored on shape, colour purity, isolation and size.
 
-Search, then refine (the cost stays near the floor any colour detector pays, one ``cvtColor`` and one
-``inRange`` on the frame):
-
-1. Search: the frame at half resolution (from 320 px wide up; a 16 px target is still 8 px there),
-   one ``cvtColor``, one ``inRange``, a 3x3 opening, external contours. The ranges as the fewest ``inRange``
-   calls (red in one piece) and the V bound that follows the frame's exposure are ``pilot.vision.hsv.colour``.
-2. Refine (refine.py, as are steps 3 and 4): the few largest blobs filling at least ``SEARCH_FILL`` of
-   their box's disc are looked at again at full resolution, in a window around each: a 3x3 median (sensor noise
-   in a ball's shaded side would fray its outline), mask, 3x3 opening and closing, the blob's contours, and a
-   score 0..1 each, a product of ramps each between a value no target shows and one every target shows (chosen
-   on the tuning photos of bench/vision); measuring stops as soon as the product so far is below ``hsv.min_score``:
-
-   * shape: the share of the contour lying on its minimum enclosing circle ("arc support": a disk ~1, a
-     disk with 30 % hidden behind an edge ~0.7, a square ~0.3) or, where that is low, on an ellipse fitted
-     robustly to it (a ball seen through a perspective warp, or with a stub of background attached; its ramp
-     is stricter, as an ellipse fits a square's sides better than the enclosing circle does), solidity, fill of
-     that circle, and the aspect and fill of its minimum-area rectangle (a rotated bar has a square bounding box; a
-     disc fills pi / 4 of its rectangle, a small square blurred round all of it; a blob whose outline keeps to its
-     circle may be longer: a ball partly hidden, or with its shaded side out of the mask).
-   * colour purity: mean saturation (a small round blob's on its core: blur blends its rim), and how far the
-     mean hue sits from the middle of the range (orange and red-brown sit near its edge, the target's red in the
-     middle; read without clipped pixels where it holds the score down: an over-exposed red reads orange).
-   * isolation: the share of the ring around the circle (1.25 to 1.75 radii, sampled) that is of the
-     target's colour: a ball stands apart; a hole in a red poster's print, a piece of a red box or of a brick
-     wall does not.
-   * size: the range the apparent diameter implies (known diameter, field of view) must be plausible, and
-     a blob under 18 px is scored down (too few pixels to show its shape).
-   * texture: a blob with round search blobs of its size close around it scores 0 (texture.py).
-
-   The circle, not the blob's centroid, gives the position: a ball's dark side or a covered part moves
-   a centroid, not the circle through its rim.
-3. Split: a ball in front of something of its colour (a red motorbike, a red-brown saucer) joins it in the
-   mask. Unless a candidate already scores ``SPLIT_UNLESS``, the largest search blobs filling less than
-   ``SPLIT_FILL`` of their box's disc are split (split.py): by shape, around the widest discs that
-   bulge out of them, the mask opened by a disc half as wide (necks go, the ball stays whole; its arcs count
-   only on the mask's real edge, as an opened square is round); and by hue, when their pixels fall in two hue
-   classes (a ball a few units off a red-brown saucer), each class's round pieces refined in its own range, or
-   else by saturation (a crimson ball on a glossy orange-red saucer of its hue), each piece then counting only
-   with a rim all round (rim.py) and not in a pattern of round pieces of its size. A search blob that
-   measures as a ball there and gave nothing in its window may be joined at full resolution to a strip the
-   search's opening took off (a rail, a beam): it is split by shape too, its piece counting only with a full shape
-   score (an opening rounds a square's corners; on the dev seeds of bench/vision, 11 balls more of about 7,300,
-   none fewer, the same false detections).
-4. Edges: a ball on a surface of its colour (a red-brown saucer, a red motorbike's tank) is in one piece with
-   it even in hue; if still nothing scores ``SPLIT_UNLESS``, the largest search blobs' windows are cut by the
-   image's edges (edges.py) and the round pieces from ``hsv_edges.MIN_SIZE`` measured, isolation
-   then being the share of the rim just outside them that is an edge or off the mask.
-
-A frame where nothing scores ``SECOND_LOOK_UNLESS`` gets a second look, steps 1 to 4 with the V bound 0.8 times as
-high and the mask grown from it down to ``V_FLOOR`` (``hsv_colour.Grown``), keeping what scores ``SECOND_LOOK_MIN``
-(in place of a first measure at its place that scored less): a ball's shaded side, or a ball in dim or back light,
-falls below the bound. Grown, on the tuning photos' dev seeds: 30 % hidden balls 88.2 -> 90.9 %, dim 89.2 -> 90.4 %,
-none lower, the same false detections in 4,800 empty and distractor views. Its splits (steps 3 and 4) skip the
-blobs the first look split or cut and the grown mask left as they were (the same result again): on three dev seed
-sets, 0.6-3.1 points more in most conditions (30 % hidden +1.8 / +2.5 / +3.1), the same false detections, the
-median frame's time the same, the mean of empty views' 10-25 % more.
-
-A noisy frame (a camera's gain in dim light: noise.py) then gets steps 1 to 4 again on the frame
-smoothed, keeping what scores as much: noise frays a dark ball's outline in the mask, and a ball joined to something
-of its colour needs the splits there too (with steps 1 and 2 only, on bench/vision's dev seeds of the noise
-condition, 4-7 balls fewer of about 165 per photo set, with the same false detections). The laser's aim check reads
-such a frame's centre smoothed too.
-
-A frame where nothing scores ``SECOND_LOOK_UNLESS`` after these looks gets a rim look (measure.py): the
-blobs that their arcs or ring held down are measured again with their rim support (rim.py), an edge all
-round them in brightness (or, short of that, in a colour channel), which stands in for the arcs (a mask frayed by
-JPEG's colour blocks, noise or shade) and for isolation (a ball on a surface of its colour). Pieces cut by edges
-under ``hsv_edges.MIN_SIZE`` count with a brightness rim of ``hsv_refine.SMALL_RIM``.
-
-A frame where still nothing scores ``SECOND_LOOK_UNLESS`` gets a circle look (circles.py): in the first
-look's ``CIRCLE_BLOBS`` largest blobs' windows, circles of brightness edges, then of colour edges (the best of each
-octave of radii), with the target's colour inside (one circle to a window: several are a texture of round things, a
-flower's petals). A ball on a textured surface of its colour, which even the edges cut into pieces (its shading is
-an edge inside it), is one blob with that surface; only its rim tells it apart. A window with no circle whose rim is
-whole takes one whose rim is nearly so and whose middle is lit as a ball's (dome.py): JPEG's blocks break
-a ball's rim in places. It costs about 2 ms a window, in frames with no ball.
-
-Every look drops the blobs from ``hsv_inside.FROM`` px across that are brightness edges inside (inside.py):
-a round texture of the target's colour (a dahlia's heart, its red cups merged by JPEG's blocks), not a plain ball;
-and the blobs measured on their rim that are hollow (hollow.py): brighter than their middle, in the
-target's colour, further round than a ball lit from one side can be (a dahlia's single cup under blur, whose lit
-wall is a brightness edge all round).
-
-A tracked ball the frame's look misses gets a closer look where the track expects it (``candidates_near``, called
-by pilot/vision/detect.py): that window refined with the V bound ``NEAR_GAIN`` times as high.
-
-A search blob from ``HALF_TRY`` px across is first measured on the search itself: a plain disc scoring high
-there, or any blob from ``HALF_MEASURE`` px, skips the refinement and its fixed cost.
-"""
+Search at half resolution (one ``cvtColor``, one ``inRange``), then refine the largest round blobs at full
+resolution and score each 0..1 as a product of ramps (``score.py``). When nothing scores well enough, fallback looks
+follow in order, each only if the one before found nothing: splits of blobs joined to something of the target's
+colour (``split.py``, ``edges.py``), a second look with a lower V bound, a smoothed look of a noisy frame
+(``noise.py``), a rim look (``rim.py``) and a circle look (``circles.py``). Every look drops textures (``inside.py``,
+``texture.py``) and hollows (``hollow.py``). The circle through the rim, not the blob's centroid, gives the position.
+The per-frame budget (``vision.budget_ms``) stops the fallback looks when time runs out. The step-by-step account
+and the figures behind each step: bench/vision/HISTORY.md, "The rule-grown detector's docstrings"."""
 
 from __future__ import annotations
 

@@ -1,26 +1,8 @@
 """A ball is not hollow: the colour-ball detector's (detector.py) check that a round blob is not a cup.
 
-A convex matte ball lit by one light (and any even ambient light) is brighter than its middle on less than half of
-any circle around its middle: the points whose surface turns towards the light more than the middle's lie on one
-side of a line through it. A cup, a ring, a hollow is the other way round: its lit wall is brighter than its
-shaded inside all round. The dahlia close up among scikit-learn's photos is such cups, 15-24 px across, red and
-round with a sharp rim; under blur and JPEG they fired the detector in empty and distractor views. A ball lit from
-two opposite sides at once (rim lighting) would read hollow too; a room's lights above it do not.
-
-Read on ``SECTORS`` sectors at ``RADII`` of the blob's radius, each sector's samples' grey against the mean grey of
-the middle's. A sector is lit when it is brighter by ``MARGIN`` and of the target's colour (an occluder in front of
-the ball is not the ball: otherwise 97 of the bench's 30 % occluded balls on the dev seeds read 7-10 of 12). Hollow: at
-least ``HOLLOW_SECTORS`` lit, spread over at least ``HOLLOW_SPREAD`` sectors in a row. A lit ball has 6 of 12 at
-most, in a row; a motion-blurred ball of 16-20 px on a bright background reads 7-8 in a row (its background blurs
-into its rim), the dahlia's cups 7-10 in two arcs or one of 9 and more.
-
-On bench/vision's dev seed sets (three, 10,500 views) it took none of the 4,794 balls found, and removed 8 of the
-validation photos' 14 detections in empty views and 3 of their 13 in distractor views; on 7,500 more dev views
-(seeds 81 and 83), none of the balls, and 13 of the validation photos' 47 detections in empty and distractor views
-(the tuning photos' 8 stayed). The detector reads it only for blobs measured on their rim (``Features.rim``), where
-a cup's lit wall passes for a ball's rim: read for every blob, it removed one detection more of the 18,000 views
-and cost 7 % of the median frame (28 µs a call in a frame, its numpy and OpenCV calls cold).
-"""
+A convex matte ball lit from one side is brighter than its middle on less than half of any circle around it; a
+cup's lit wall is brighter than its shaded inside all round. Read on sectors at a few radii, each counted lit when
+brighter than the middle and of the target's colour. Figures: bench/vision/HISTORY.md."""
 
 from __future__ import annotations
 

@@ -1,28 +1,9 @@
 """Rim support for the colour-ball detector (detector.py): how much of a circle near a blob's is an edge in the
-image's brightness, facing the circle's centre.
+image's brightness (or, short of that, in a colour channel), facing the circle's centre.
 
-A ball's outline is an edge in brightness all the way round, whatever its colour mask shows: JPEG keeps the
-brightness at full resolution while it blocks the colour out in 8 or 16 px squares, and a ball lying on a surface
-of its own colour still stands out from it by its shading. A red shape's outline is an edge too, but not on a
-circle, and a red surface's texture is an edge here and there, not all the way round.
-
-The circle is looked for near the one given, a blob's enclosing circle or one the circle look (circles.py)
-voted for (``SCALES`` x ``SHIFTS``: a frayed mask or a coarse vote moves and sizes it a little), all circles sampled
-in one pass.
-
-A ball on a surface of its own colour may differ from it more in one channel than in brightness (a crimson ball on
-an orange-red saucer: the green and blue channels step, the grey level barely). Where the brightness rim falls short
-of ``WHOLE``, a circle from ``COLOUR_FROM`` px across is measured again in each colour channel, and the best
-channel's rim counts from ``COLOUR_MIN`` round an inside with no more brightness edges than a plain ball's
-(inside.py, at any size). The channel that tells a ball from its ground does so all round; a point counted
-when any channel had an edge there gave a textured ground three chances (on 6,000 dev negatives, 9 detections more
-against none, for 34 balls more of 4,800 on the dev seeds). On the dev seeds of bench/vision's tuning photos (not
-the report's), the true circle of the 117 balls that had no candidate near them had a brightness rim of 0.8 or more
-for 23 of them, one in any channel at each point for 87.
-What else had a colour rim was a red lamp with a yellow glow inside (the tuning photos' motorbike, 17-24 px): the
-inside check, which only balls from 40 px pay for otherwise, read 0.20-0.27 there, at most 0.18 on the balls the
-colour rim found.
-"""
+A ball's outline is an edge all the way round whatever its colour mask shows (JPEG blocks the colour, not the
+brightness); a red shape's outline is not on a circle, and a texture is an edge here and there. The circle is looked
+for near the one given, scaled and shifted a little. Figures: bench/vision/HISTORY.md."""
 
 from __future__ import annotations
 
