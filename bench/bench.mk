@@ -23,6 +23,8 @@
 #                         simulator's cost per frame; writes bench/flight/RESULTS.md (BENCH_FLIGHT_FLAGS=--seeds 2
 #                         for a shorter one; "--detector hsv --first-seed 500 --seeds 4": seeds never tuned on,
 #                         bench/flight/RESULTS-hsv-from500.md)
+#   make bench-sidechan   the live view under 300 hostile clients (the loop's rate, gaps, memory), disk-full flights
+#                         and the generator killed mid-run; writes bench/sidechan/RESULTS*.md
 #   make bench            every part's benchmark: bench-protocol, bench-generator, bench-firmware
 #                         (firmware/firmware.mk), bench-pilot (pilot/pilot.mk), bench-vision, bench-ide
 #                         (bench/ide/bench.mk), bench-rust-c (tests/targets/targets.mk) and bench-tools
@@ -37,7 +39,7 @@ VISION_DEV_RECORD ?= current
 BENCH_FLIGHT_FLAGS ?=
 
 .PHONY: bench bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-vision-dev bench-ide bench-tools \
-        bench-flight
+        bench-flight bench-sidechan
 
 # Run benchmarks one at a time (not with make -j): they time each other otherwise.
 bench: bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-ide bench-rust-c bench-tools \
@@ -62,6 +64,9 @@ bench-generator: deps
 BENCH_TOOLS_FLAGS ?=
 bench-tools: deps firmware-host
 	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.tools.run $(BENCH_TOOLS_FLAGS)
+
+bench-sidechan: deps firmware-host
+	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.sidechan.liveview_load $(BENCH_SIDECHAN_FLAGS)
 
 # Recipes come from firmware/firmware.mk and pilot/pilot.mk; a part that has none yet benchmarks nothing.
 bench-firmware bench-pilot:

@@ -1,0 +1,141 @@
+"""The live view under load: simulated flights with and without 300 hostile clients, the loop's rate.
+
+Each round flies the same simulated flight (scenario ahead, seed 2, the firmware's host build as the drone)
+twice with ``--serve`` on: once with no client, once with ``bench.sidechan.swarm`` (in its own process)
+keeping 300 clients going (connected viewers, idle sockets, slow readers, resets), at the lowest priority
+(``nice 19``: on the 2 shared cores of this machine the clients would otherwise take the processor the
+simulated drone and the pilot need; a real crowd runs on other machines). Paced flights hold the
+loop to real time, as a real camera does (the rate and the longest gap between two ticks say whether it
+keeps up); unpaced ones run as fast as the machine allows (what the server's thread costs the loop).
+Reports the rates, the longest gap, tracebacks, the pilot process's memory, and writes RESULTS.md.
+
+    PILOT_VIRTUAL_DRONE=build/firmware/host/virtual_drone python -m bench.sidechan.liveview_load
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+from bench.tools.run import Rate
+from pilot.app.liveview import LiveView
+from pilot.app.observers import StopSwitch, WallClockPacing
+from pilot.app.runner import Observer
+from pilot.app.sim_flight import fly
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parents[1]
+SWARM = {"viewers": 75, "idle": 75, "slow": 75, "reset": 75}
+
+
+class Gaps(Rate):
+    @property
+    def max_gap_ms(self) -> float:
+        return max(b - a for a, b in zip(self.times, self.times[1:], strict=False)) * 1000
+
+
+def rss_mb() -> float:
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) / 1024
+    return float("nan")
+
+
+def one_flight(paced: bool, load: bool, executable: str | None, seconds: float) -> dict[str, object]:
+    gaps = Gaps()
+    log: list[str] = []
+    tracebacks = [0]
+    hook = threading.excepthook
+    threading.excepthook = lambda args: tracebacks.__setitem__(0, tracebacks[0] + 1)
+    view = LiveView("127.0.0.1", 0, StopSwitch(), log=log.append)
+    observers: list[Observer] = [gaps, view]
+    if paced:
+        observers.append(WallClockPacing())
+    swarm = None
+    peak = {"rss": rss_mb(), "connections": 0, "viewers": 0}
+
+    def watch() -> None:
+        while swarm is not None and swarm.poll() is None:
+            peak["rss"] = max(peak["rss"], rss_mb())
+            peak["connections"] = max(peak["connections"], view.server.connections)
+            peak["viewers"] = max(peak["viewers"], view.server.viewers)
+            time.sleep(0.1)
+
+    if load:
+        args = [f"--{k}={v}" for k, v in SWARM.items()]
+        swarm = subprocess.Popen(["nice", "-n", "19", sys.executable, "-m", "bench.sidechan.swarm", view.url, *args,
+                                  f"--seconds={seconds}"], cwd=REPO, stdout=subprocess.PIPE, text=True)
+        time.sleep(2.0)  # the crowd is in before take-off
+        threading.Thread(target=watch, daemon=True).start()
+    rss0 = rss_mb()
+    try:
+        flight = fly("ahead", 2, executable=executable, observers=observers, max_seconds=seconds)
+    finally:
+        view.close()
+        threading.excepthook = hook
+    clients: dict[str, object] = {}
+    if swarm is not None:
+        out, _ = swarm.communicate(timeout=seconds + 60)
+        clients = json.loads(out)
+    return {"paced": paced, "load": load, "hz": round(gaps.hz, 2), "max_gap_ms": round(gaps.max_gap_ms, 1),
+            "ticks": len(gaps.times), "disarmed": not flight.final_armed, "altitude": round(flight.final_altitude, 2),
+            "summary": flight.summary(), "tracebacks": tracebacks[0], "log_lines": len(log),
+            "rss_before_mb": round(rss0, 1), "rss_peak_mb": round(max(peak["rss"], rss_mb()), 1),
+            "peak_connections": peak["connections"], "peak_viewers": peak["viewers"],
+            "dropped_frames": view.server.dropped, "refused": view.server.refused,
+            "evicted": view.server.evicted, "server_cpu_s": round(view.server.cpu_s, 2),
+            "wall_s": round(flight.wall_seconds, 1), "clients": clients}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="liveview_load")
+    p.add_argument("--rounds", type=int, default=3)
+    p.add_argument("--seconds", type=float, default=30.0)
+    p.add_argument("--no-write", action="store_true")
+    args = p.parse_args(argv)
+    executable = os.environ.get("PILOT_VIRTUAL_DRONE")
+    runs: list[dict[str, object]] = []
+    for r in range(args.rounds):
+        for paced in (True, False):
+            for load in (False, True):
+                run = one_flight(paced, load, executable, args.seconds)
+                runs.append(run)
+                print(f"round {r + 1} {'paced' if paced else 'unpaced'} {'300 clients' if load else 'no client'}: "
+                      f"{run['hz']} Hz, longest gap {run['max_gap_ms']} ms, {run['tracebacks']} tracebacks, "
+                      f"rss {run['rss_before_mb']}->{run['rss_peak_mb']} MB, {run['clients']}", flush=True)
+    lines = ["# The live view under load (`make bench-sidechan`)", "",
+             f"{args.rounds} rounds; each: the simulated flight (ahead, seed 2, {args.seconds:g} s at most) paced "
+             "and unpaced, with no client and with 300 (75 each: viewers, idle, slow, resetting), default limits "
+             "(4 viewers, 32 sockets).", "",
+             "| mode | clients | rate (Hz, median) | rate vs no client | longest gap (ms, max) | tracebacks | "
+             "peak RSS (MB) | peak sockets | frames dropped |", "|---|---|---|---|---|---|---|---|---|"]
+    for paced in (True, False):
+        base = statistics.median(float(str(r["hz"])) for r in runs if r["paced"] == paced and not r["load"])
+        for load in (False, True):
+            sel = [r for r in runs if r["paced"] == paced and r["load"] == load]
+            hz = statistics.median(float(str(r["hz"])) for r in sel)
+            lines.append(
+                f"| {'paced' if paced else 'unpaced'} | {300 if load else 0} | {hz:.2f} "
+                f"| {100 * (hz / base - 1):+.1f} % | {max(float(str(r['max_gap_ms'])) for r in sel):.0f} "
+                f"| {sum(int(str(r['tracebacks'])) for r in sel)} "
+                f"| {max(float(str(r['rss_peak_mb'])) for r in sel):.0f} "
+                f"| {max(int(str(r['peak_connections'])) for r in sel)} "
+                f"| {sum(int(str(r['dropped_frames'])) for r in sel)} |")
+    lines += ["", "Each run:", "", "```", *(json.dumps(r) for r in runs), "```", ""]
+    text = "\n".join(lines)
+    print(text)
+    if not args.no_write:
+        (HERE / "RESULTS.md").write_text(text)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
