@@ -286,7 +286,7 @@ def _fly_real(args: argparse.Namespace, cfg: PilotConfig) -> int:
                     raise hint from exc
                 sink = link
             if args.record:
-                recorder = Recorder(args.record, fps=cfg.link.rate_hz)
+                recorder = Recorder(args.record, fps=cfg.link.rate_hz, on_failure=cfg.record_failure)
                 observers.append(recorder)
                 for entry in early:
                     recorder.on_link(entry)

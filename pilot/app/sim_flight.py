@@ -136,7 +136,9 @@ def fly(
         cfg = dataclasses.replace(cfg, detector=detector_name)
     scenario = make_scenario(scenario_name, seed, noise=noise, max_wind=max_wind, gusts=gusts)
     detector = make_detector(cfg)
-    recorder = Recorder(record_dir, fps=cfg.link.rate_hz) if record_dir is not None else None
+    recorder = None
+    if record_dir is not None:
+        recorder = Recorder(record_dir, fps=cfg.link.rate_hz, on_failure=cfg.record_failure)
     wall0 = time.perf_counter()
     tick_ms = round(1000.0 / cfg.link.rate_hz)
     try:
@@ -177,7 +179,8 @@ def fly(
             state = world.state
             picture = None
             if recorder is not None:
-                picture = str(recorder.path_png(scenario, score.path))
+                drawn = recorder.path_png(scenario, score.path)
+                picture = str(drawn) if drawn is not None else None
                 recorder.write(
                     {
                         "result": {

@@ -116,9 +116,11 @@ class PilotConfig:
     aruco: ArucoConfig = field(default_factory=ArucoConfig)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     link: LinkConfig = field(default_factory=LinkConfig)
+    record_failure: str = "continue"  # when --record's disk fails: "continue" the flight, or "land"
 
 
 DETECTORS = ("hsv", "aruco")
+RECORD_FAILURES = ("continue", "land")
 
 T = TypeVar("T")
 
@@ -230,6 +232,10 @@ def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
     _check_ranges(config, where)
     if config.detector not in DETECTORS:
         raise ConfigError(f"{where}: option 'detector' must be one of {DETECTORS}, got {config.detector!r}")
+    if config.record_failure not in RECORD_FAILURES:
+        raise ConfigError(
+            f"{where}: option 'record_failure' must be one of {RECORD_FAILURES}, got {config.record_failure!r}"
+        )
     for i, (lo, hi) in enumerate(config.hsv.ranges):
         for name, triple in (("low", lo), ("high", hi)):
             h, s, v = triple
