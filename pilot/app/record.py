@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import math
 import sys
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Any
@@ -59,6 +60,8 @@ def prepare_directory(directory: str | Path, force: bool = False) -> Path:
         for name in existing:
             (path / name).unlink()
         path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):  # an existing folder may still be unwritable (a read-only disk)
+            pass
     except OSError as exc:
         raise PilotError(f"option --record: cannot write into {str(path)!r}: {exc.strerror or exc}") from exc
     return path
