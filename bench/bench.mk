@@ -68,6 +68,7 @@ bench-tools: deps firmware-host
 bench-sidechan: deps firmware-host
 	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.sidechan.liveview_load $(BENCH_SIDECHAN_FLAGS)
 	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.sidechan.disk_full
+	$(PY) -m bench.sidechan.generator_kills
 
 # Recipes come from firmware/firmware.mk and pilot/pilot.mk; a part that has none yet benchmarks nothing.
 bench-firmware bench-pilot:
