@@ -7,8 +7,8 @@
   flights; a real flight has no position to draw).
 
 The recording is best effort: a full disk or any I/O error ends it with one line on stderr and the flight
-goes on (``record_failure: continue``, the default) or lands as after Stop (``record_failure: land``); it
-never raises into the pilot's loop or the link.
+goes on (``record_failure: continue``, the default) or stops as after Stop, laser off, land, disarm
+(``record_failure: stop``); it never raises into the pilot's loop or the link.
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ RECORDING_FILES = (VIDEO, LOG, PATH_PICTURE)
 
 
 class RecordingFailed(StopRequested):
-    """The recording failed and the config says to land (``record_failure: land``)."""
+    """The recording failed and the config says to stop the flight (``record_failure: stop``)."""
 
 
 def prepare_directory(directory: str | Path, force: bool = False) -> Path:
@@ -107,7 +107,7 @@ class Recorder(Closing):
             return
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc) or type(exc).__name__
         self.failed = f"{what}: {reason}"
-        then = "landing (record_failure: land)" if self.on_failure == "land" else "the flight goes on"
+        then = "landing (record_failure: stop)" if self.on_failure == "stop" else "the flight goes on"
         self._warn(f"pilot: recording stopped: {self.failed}; {then}")
         self.close()
 
@@ -143,7 +143,7 @@ class Recorder(Closing):
         self.write({"t": round(self._since_start(entry.t), 3), "link": entry.kind, "data": entry.data})
 
     def on_tick(self, tick: Tick) -> None:
-        if self.failed and self.on_failure == "land":
+        if self.failed and self.on_failure == "stop":
             raise RecordingFailed(f"the recording failed ({self.failed})")
         if self._closed:
             return

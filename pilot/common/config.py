@@ -117,11 +117,11 @@ class PilotConfig:
     aruco: ArucoConfig = field(default_factory=ArucoConfig)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     link: LinkConfig = field(default_factory=LinkConfig)
-    record_failure: str = "continue"  # when --record's disk fails: "continue" the flight, or "land"
+    record_failure: str = "continue"  # --record's disk failed: "continue" the flight, or "stop" it (land, disarm)
 
 
 DETECTORS = ("hsv", "aruco")
-RECORD_FAILURES = ("continue", "land")
+RECORD_FAILURES = ("continue", "stop")
 
 T = TypeVar("T")
 

@@ -1,5 +1,5 @@
 """``--record`` is best effort and apart from the link: a full disk or an I/O error ends the recording with one
-line, the flight goes on (or lands, with ``record_failure: land``) and ends with its summary; the link's own
+line, the flight goes on (or lands, with ``record_failure: stop``) and ends with its summary; the link's own
 log is bounded and a failing log subscriber never reaches the link's caller."""
 
 from __future__ import annotations
@@ -57,12 +57,12 @@ def test_a_full_disk_ends_the_recording_with_one_line_and_raises_nothing(tmp_pat
 
 def test_record_failure_land_stops_the_loop_at_its_next_tick(tmp_path: Path) -> None:
     lines: list[str] = []
-    rec = Recorder(tmp_path, on_failure="land", open_log=lambda _: FullDisk(1), warn=lines.append)
+    rec = Recorder(tmp_path, on_failure="stop", open_log=lambda _: FullDisk(1), warn=lines.append)
     rec.on_tick(_tick(0))
     rec.write({"x": 1})  # the disk is full
     with pytest.raises(RecordingFailed, match="the recording failed"):
         rec.on_tick(_tick(1))
-    assert lines[0].endswith("; landing (record_failure: land)")
+    assert lines[0].endswith("; landing (record_failure: stop)")
 
 
 def test_the_links_log_is_bounded_and_a_failing_subscriber_is_dropped(capfd: pytest.CaptureFixture[str]) -> None:
@@ -87,7 +87,7 @@ def _full_after(writes: int) -> object:
     return opener
 
 
-@pytest.mark.parametrize(("writes", "policy"), [(2, "continue"), (700, "land")])
+@pytest.mark.parametrize(("writes", "policy"), [(2, "continue"), (700, "stop")])
 def test_a_disk_full_mid_flight_still_lands_disarms_and_prints_the_summary(
     writes: int, policy: str, virtual_drone: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -101,7 +101,7 @@ def test_a_disk_full_mid_flight_still_lands_disarms_and_prints_the_summary(
     assert err.count("pilot: recording stopped:") == 1, err
     assert "drone:     laser off, disarmed, altitude 0.00 m" in out, out + err
     assert out.startswith("ahead      seed   2 hsv "), out  # the flight's summary
-    if policy == "land":  # landed early: the flight did not do its job
-        assert code == 1 and "landing (record_failure: land)" in err and "stopped by RecordingFailed" in err
+    if policy == "stop":  # landed early: the flight did not do its job
+        assert code == 1 and "landing (record_failure: stop)" in err and "stopped by RecordingFailed" in err
     else:
         assert code == 0 and "reached and lit" in out
