@@ -62,8 +62,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{parser.prog} {__version__} (spec {shown}: {spec.name} {spec.version}, "
               f"fingerprint {spec.short_fingerprint})")
         return 0
-    from .render import render_all, stale_files, write_atomically  # Jinja only for a valid spec
+    from .render import render_all  # Jinja only for a valid spec
     from .safety import report as safety_report
+    from .writing import stale_files, write_atomically
 
     files = render_all(spec)
     if opts.check:
@@ -73,7 +74,8 @@ def main(argv: list[str] | None = None) -> int:
         for line in problems:
             print(line)
         if problems:
-            print(f"{len(problems)} generated file(s) out of date: run `python -m generator`", file=sys.stderr)
+            print(f"{len(problems)} generated file(s) out of date or left over: run `python -m generator`",
+                  file=sys.stderr)
             return EXIT_STALE
         print(f"{len(files)} generated files match {shown} (fingerprint {spec.short_fingerprint})")
         return 0

@@ -6,7 +6,6 @@ import contextlib
 import functools
 import json
 import os
-import tempfile
 from pathlib import Path
 
 import jinja2
@@ -140,40 +139,3 @@ def render_all(spec: Spec) -> dict[str, bytes]:
                 path = f"{target.out_dir}/{out_path}" if target.out_dir else out_path
                 files[path] = (text if target.own_header else _with_header(path, text, spec)).encode("utf-8")
     return files
-
-
-def stale_files(files: dict[str, bytes], out_dir: Path) -> list[str]:
-    """Paths whose content on disk differs from `files`, each with why."""
-    problems = []
-    for rel, content in sorted(files.items()):
-        path = out_dir / rel
-        if not path.exists():
-            problems.append(f"missing: {path}")
-        elif path.read_bytes() != content:
-            problems.append(f"stale: {path}")
-    return problems
-
-
-def write_atomically(files: dict[str, bytes], out_dir: Path) -> list[str]:
-    """Write every file or none: stage each beside its destination, then rename all into place.
-
-    Returns the paths that changed."""
-    changed = [rel for rel in sorted(files)
-               if not (out_dir / rel).exists() or (out_dir / rel).read_bytes() != files[rel]]
-    staged: list[tuple[str, Path]] = []
-    try:
-        for rel in changed:
-            dest = out_dir / rel
-            dest.parent.mkdir(parents=True, exist_ok=True)
-            fd, tmp_name = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=dest.parent)
-            os.fchmod(fd, 0o644)  # mkstemp's 0600 would make generated files private
-            with os.fdopen(fd, "wb") as fh:
-                fh.write(files[rel])
-            staged.append((rel, Path(tmp_name)))
-    except BaseException:
-        for _, tmp in staged:
-            tmp.unlink(missing_ok=True)
-        raise
-    for rel, tmp in staged:
-        os.replace(tmp, out_dir / rel)
-    return changed

@@ -32,7 +32,8 @@ from ..vision.calibrate import Roi, calibrate_to_config, preview_path
 from ..vision.calibrate_room import learn_room, room_summary
 from ..vision.detect import make_detector
 from ..vision.picam import PicameraSource
-from .cli_options import LiveSession, check_sources, port_error_hint, stop_note
+from .cli_options import MAX_VIEWERS, LiveSession, check_sources, port_error_hint, stop_note
+from .liveserver import DEFAULT_LIMITS
 from .observers import LaserTally
 from .record import Recorder
 from .runner import DryRunSink, Observer, RealPacer, Sink, StatusLine, run
@@ -70,6 +71,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true", help="let --record overwrite an earlier recording in DIR")
     p.add_argument("--serve", metavar="[HOST:]PORT", help="serve a live view with an emergency Stop (host "
                    "127.0.0.1 unless given; the URL, with its token, is printed at start-up)")
+    p.add_argument("--serve-viewers", type=int, default=DEFAULT_LIMITS.viewers, metavar="N",
+                   help=f"live view: video streams at once, 1..{MAX_VIEWERS} (default {DEFAULT_LIMITS.viewers})")
     p.add_argument("--seed", type=int, default=1, help="simulated room seed (default 1)")
     p.add_argument("--scenario", choices=SCENARIOS, default="ahead", help="simulated scenario (default ahead)")
     p.add_argument("--max-seconds", type=float, default=60.0, help="flight time limit, seconds (default 60)")
@@ -200,7 +203,7 @@ def _fly_sim(args: argparse.Namespace, cfg: PilotConfig) -> int:
     status = None if args.no_status else StatusLine()
     if status is not None:
         observers.append(status)
-    live = LiveSession(args.serve, simulated=True) if args.serve else None
+    live = LiveSession(args.serve, simulated=True, viewers=args.serve_viewers) if args.serve else None
     if live is not None:
         observers.extend(live.observers())
     try:
@@ -293,12 +296,12 @@ def _fly_real(args: argparse.Namespace, cfg: PilotConfig) -> int:
                     raise hint from exc
                 sink = link
             if args.record:
-                recorder = Recorder(args.record, fps=cfg.link.rate_hz)
+                recorder = Recorder(args.record, fps=cfg.link.rate_hz, on_failure=cfg.record_failure)
                 observers.append(recorder)
                 for entry in early:
                     recorder.on_link(entry)
             if args.serve:
-                live = LiveSession(args.serve, simulated=False)
+                live = LiveSession(args.serve, simulated=False, viewers=args.serve_viewers)
                 observers.extend(live.observers())
             controller = Controller(cfg.controller)
             result = run(

@@ -1,22 +1,26 @@
-"""Start-up checks and the live-view session of the command line (``--serve``, ``--record``/``--force``,
-the frame-source options, the serial port's permission hint), kept apart from the flight code in cli.py.
+"""Start-up checks and the live-view session of the command line (``--serve``/``--serve-viewers``,
+``--record``/``--force``, the frame-source options, the serial port's permission hint), kept apart from the
+flight code in cli.py.
 
 Every check runs before anything flies or is written, and fails with one line that names the option."""
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import errno
 import sys
 from collections.abc import Sequence
 
 from ..common.errors import PilotError
+from .liveserver import DEFAULT_LIMITS
 from .liveview import LiveView, parse_address
 from .observers import StopSwitch, WallClockPacing
 from .record import prepare_directory
 from .runner import Observer
 
 SOURCE_OPTIONS = ("camera", "video", "images")
+MAX_VIEWERS = 64
 
 
 def check_sources(args: argparse.Namespace) -> None:
@@ -26,6 +30,8 @@ def check_sources(args: argparse.Namespace) -> None:
         raise PilotError(f"options {' and '.join(given)} exclude each other: pick one frame source")
     if args.force and not args.record:
         raise PilotError("option --force only applies to --record DIR")
+    if not 1 <= args.serve_viewers <= MAX_VIEWERS:
+        raise PilotError(f"option --serve-viewers must be within 1..{MAX_VIEWERS}, got {args.serve_viewers}")
     if args.record:
         prepare_directory(args.record, force=args.force)
 
@@ -46,10 +52,12 @@ def port_error_hint(exc: BaseException, port: str) -> PilotError | None:
 class LiveSession:
     """``--serve``: the live view, its stop switch and (for a simulated flight) wall-clock pacing."""
 
-    def __init__(self, address: str, *, simulated: bool) -> None:
+    def __init__(self, address: str, *, simulated: bool, viewers: int = DEFAULT_LIMITS.viewers) -> None:
         host, port = parse_address(address)
         self.stop = StopSwitch()
-        self.view = LiveView(host, port, self.stop)
+        limits = dataclasses.replace(DEFAULT_LIMITS, viewers=viewers, connections=max(DEFAULT_LIMITS.connections,
+                                                                                      2 * viewers + 8))
+        self.view = LiveView(host, port, self.stop, limits=limits)
         self.pacing = WallClockPacing() if simulated else None
         print(f"live view: {self.view.url}  (the Stop button lands the drone; the URL is its key)", flush=True)
 

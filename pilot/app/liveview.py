@@ -1,6 +1,7 @@
 """``--serve HOST:PORT``: a live view of the flight in a browser, with an emergency Stop.
 
-A standard-library HTTP server in daemon threads. Every path starts with a random token printed at
+A single-threaded, non-blocking server (``liveserver.py``: bounded viewers and sockets, timeouts, frames
+dropped for a slow viewer, client errors as one line). Every path starts with a random token printed at
 start-up (``http://127.0.0.1:8080/<token>/``); anything else is 404, so the page and its Stop need the URL.
 
 * ``/<token>/``             the page (``liveview.html``)
@@ -10,21 +11,20 @@ start-up (``http://127.0.0.1:8080/<token>/``); anything else is 404, so the page
 * ``POST /<token>/stop``    asks the pilot to stop: the loop's next tick raises ``StopRequested`` and the
                             pilot runs its safe sequence (laser off, land, disarm), as after Ctrl-C
 
-The pilot loop only stores a reference to the newest tick (the sources hand out a new image per frame);
-the stream threads draw the overlay and encode each frame once, off the control loop.
+The pilot loop only stores a reference to the newest tick under a short lock (the sources hand out a new
+image per frame); the server's thread draws the overlay and encodes each frame once, off the control loop.
 """
 
 from __future__ import annotations
 
-import contextlib
 import json
 import secrets
+import sys
 import threading
 import time
 from collections import deque
 from collections.abc import Callable
 from http import HTTPStatus
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from importlib import resources
 from typing import Any
 
@@ -32,6 +32,7 @@ import cv2
 import drone_protocol as dp
 
 from ..common.errors import PilotError
+from .liveserver import DEFAULT_LIMITS, Limits, Response, Server, Stream
 from .observers import StopSwitch
 from .overlay import annotate
 from .runner import Tick
@@ -59,19 +60,17 @@ class _Shared:
     """What the loop thread hands to the server threads, under one lock."""
 
     def __init__(self) -> None:
-        self.cond = threading.Condition()
+        self.lock = threading.Lock()
         self.tick: Tick | None = None
         self.t = 0.0
         self.capture_ms = 0.0
         self.seq = 0
         self.last_command = ""
-        self.jpeg: tuple[int, bytes] | None = None  # (seq, bytes): the newest frame, encoded once
         self.commands: deque[dict[str, Any]] = deque(maxlen=HISTORY)
         self.reply_times: deque[float] = deque()
         self.send_times: deque[float] = deque()
         self.rejected: deque[float] = deque()
         self.last_reply_t: float | None = None
-        self.viewers = 0
         self.ended = ""
 
 
@@ -86,31 +85,29 @@ class LiveView:
         *,
         token: str | None = None,
         wall_time: Callable[[], float] = time.time,
+        limits: Limits = DEFAULT_LIMITS,
+        log: Callable[[str], None] | None = None,
     ) -> None:
         self.stop = stop
         self.token = token or secrets.token_urlsafe(16)
         self._wall_time = wall_time
         self._shared = _Shared()
         self._t0: float | None = None
-        try:
-            self._server = ThreadingHTTPServer((host, port), self._handler_class())
-        except OSError as exc:
-            raise PilotError(f"option --serve: cannot listen on {host}:{port}: {exc.strerror or exc}") from exc
-        self._server.daemon_threads = True
-        self._thread = threading.Thread(target=self._server.serve_forever, name="liveview", daemon=True)
-        self._thread.start()
+        self._encoded: tuple[int, bytes] | None = None  # (seq, MJPEG part): the newest frame, encoded once
+        self._page = resources.files(__package__).joinpath("liveview.html").read_bytes()
+        self.server = Server(host, port, self._handle, self._part, limits=limits, fps=MAX_FPS,
+                             log=log or (lambda line: print(line, file=sys.stderr, flush=True)))
         self._closed = False
 
     @property
     def url(self) -> str:
-        address, port = self._server.server_address[:2]
-        host = address.decode() if isinstance(address, bytes) else str(address)
+        host, port = self.server.address
         shown = f"[{host}]" if ":" in host else host
         return f"http://{shown}:{port}/{self.token}/"
 
     @property
     def viewers(self) -> int:
-        return self._shared.viewers
+        return self.server.viewers
 
     # -- the loop's side: cheap, never waits for a browser ------------------------------------------
     def on_tick(self, tick: Tick) -> None:
@@ -118,7 +115,7 @@ class LiveView:
         if self._t0 is None:
             self._t0 = tick.t
         now = tick.t
-        with sh.cond:
+        with sh.lock:
             if tick.command is not None:
                 sh.last_command = tick.command.decode("ascii", "replace")
                 sh.send_times.append(now)
@@ -140,13 +137,12 @@ class LiveView:
                 sh.tick, sh.t, sh.seq = tick, now - self._t0, sh.seq + 1
                 # the frame's arrival on the wall clock, comparable with the browser's Date.now()
                 sh.capture_ms = self._wall_time() * 1000.0 - (time.perf_counter() - tick.frame_t) * 1000.0
-            sh.cond.notify_all()
 
     def end(self, summary: str) -> None:
         """The flight is over: the page shows `summary`; streams end."""
-        with self._shared.cond:
+        with self._shared.lock:
             self._shared.ended = summary
-            self._shared.cond.notify_all()
+        self.server.end_streams()
 
     def close(self) -> None:
         if self._closed:
@@ -154,9 +150,7 @@ class LiveView:
         self._closed = True
         if not self._shared.ended:
             self.end("the pilot has stopped")
-        self._server.shutdown()
-        self._server.server_close()
-        self._thread.join(timeout=5)
+        self.server.close()
 
     def __enter__(self) -> LiveView:
         return self
@@ -164,28 +158,43 @@ class LiveView:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    # -- the server's side -------------------------------------------------------------------------------
-    def _frame(self) -> tuple[int, bytes, float] | None:
-        """The newest frame as JPEG (encoded once, by whichever stream thread asks first)."""
+    # -- the server's side (its one thread) ------------------------------------------------------------------
+    def _part(self) -> tuple[int, bytes] | None:
+        """The newest frame as one MJPEG part, drawn and encoded once per frame."""
         sh = self._shared
-        with sh.cond:
+        with sh.lock:
             tick, t, seq, last, capture_ms = sh.tick, sh.t, sh.seq, sh.last_command, sh.capture_ms
-            if sh.jpeg is not None and sh.jpeg[0] == seq:
-                return seq, sh.jpeg[1], capture_ms
         if tick is None:
             return None
+        if self._encoded is not None and self._encoded[0] == seq:
+            return self._encoded
         ok, buf = cv2.imencode(".jpg", annotate(tick, t, last), [cv2.IMWRITE_JPEG_QUALITY, JPEG_QUALITY])
         if not ok:
             return None
         data = buf.tobytes()
-        with sh.cond:
-            if sh.jpeg is None or sh.jpeg[0] < seq:
-                sh.jpeg = (seq, data)
-        return seq, data, capture_ms
+        head = (f"--{BOUNDARY}\r\nContent-Type: image/jpeg\r\nContent-Length: {len(data)}\r\n"
+                f"X-Capture-Ms: {capture_ms:.1f}\r\nX-Frame: {seq}\r\n\r\n")
+        self._encoded = (seq, head.encode("ascii") + data + b"\r\n")
+        return self._encoded
+
+    def _handle(self, method: str, target: str, client: str) -> Response | Stream:
+        prefix = f"/{self.token}/"
+        path = target.split("?", 1)[0]
+        route = "" if path == prefix.rstrip("/") else (path[len(prefix):] if path.startswith(prefix) else None)
+        if method == "POST" and route == "stop":
+            self.stop.request(f"Stop from the live view ({client})")
+            return Response(HTTPStatus.OK, json.dumps({"stop_requested": True}).encode())
+        if method != "GET" or route not in ("", "state.json", "stream.mjpg"):
+            return Response(HTTPStatus.NOT_FOUND, b"not found\n", "text/plain")
+        if route == "":
+            return Response(HTTPStatus.OK, self._page, "text/html; charset=utf-8")
+        if route == "state.json":
+            return Response(HTTPStatus.OK, json.dumps(self.state()).encode())
+        return Stream(f"multipart/x-mixed-replace; boundary={BOUNDARY}")
 
     def state(self) -> dict[str, Any]:
         sh = self._shared
-        with sh.cond:
+        with sh.lock:
             tick, now = sh.tick, sh.t
             det = tick.detection if tick is not None else None
             since_reply = None
@@ -210,90 +219,6 @@ class LiveView:
                 "stop_requested": self.stop.requested,
                 "ended": sh.ended,
             }
-
-    def _stream(self, write: Callable[[bytes], None]) -> None:
-        sh = self._shared
-        sent = [0]  # the last frame sent to this viewer
-        last_write = -1.0
-        with sh.cond:
-            sh.viewers += 1
-        try:
-            while True:
-                with sh.cond:
-                    sh.cond.wait_for(lambda: sh.seq > sent[0] or bool(sh.ended), timeout=1.0)
-                    if sh.ended:
-                        return
-                    if sh.seq <= sent[0]:
-                        continue
-                due = last_write + 1.0 / MAX_FPS - time.monotonic()
-                if due > 0:  # then send the newest frame there is by then
-                    time.sleep(due)
-                frame = self._frame()
-                if frame is None:
-                    continue
-                seq, data, capture_ms = frame
-                sent[0] = seq
-                last_write = time.monotonic()
-                head = (f"--{BOUNDARY}\r\nContent-Type: image/jpeg\r\nContent-Length: {len(data)}\r\n"
-                        f"X-Capture-Ms: {capture_ms:.1f}\r\nX-Frame: {seq}\r\n\r\n")
-                write(head.encode("ascii") + data + b"\r\n")
-        finally:
-            with sh.cond:
-                sh.viewers -= 1
-
-    def _handler_class(self) -> type[BaseHTTPRequestHandler]:
-        view = self
-
-        class Handler(BaseHTTPRequestHandler):
-            server_version = "pilot-liveview"
-
-            def log_message(self, format: str, *args: Any) -> None:
-                pass  # the pilot's terminal shows its status line, not an access log
-
-            def _route(self) -> str | None:
-                prefix = f"/{view.token}/"
-                path = self.path.split("?", 1)[0]
-                if path == prefix.rstrip("/"):
-                    return ""
-                return path[len(prefix):] if path.startswith(prefix) else None
-
-            def _send(self, status: int, body: bytes, kind: str) -> None:
-                self.send_response(status)
-                self.send_header("Content-Type", kind)
-                self.send_header("Content-Length", str(len(body)))
-                self.send_header("Cache-Control", "no-store")
-                self.end_headers()
-                self.wfile.write(body)
-
-            def do_GET(self) -> None:
-                route = self._route()
-                if route == "":
-                    page = resources.files(__package__).joinpath("liveview.html").read_bytes()
-                    self._send(HTTPStatus.OK, page, "text/html; charset=utf-8")
-                elif route == "state.json":
-                    self._send(HTTPStatus.OK, json.dumps(view.state()).encode(), "application/json")
-                elif route == "stream.mjpg":
-                    self.send_response(HTTPStatus.OK)
-                    self.send_header("Content-Type", f"multipart/x-mixed-replace; boundary={BOUNDARY}")
-                    self.send_header("Cache-Control", "no-store")
-                    self.end_headers()
-                    with contextlib.suppress(BrokenPipeError, ConnectionResetError):  # the viewer left
-                        view._stream(self._write)
-                else:
-                    self._send(HTTPStatus.NOT_FOUND, b"not found\n", "text/plain")
-
-            def _write(self, data: bytes) -> None:
-                self.wfile.write(data)
-                self.wfile.flush()
-
-            def do_POST(self) -> None:
-                if self._route() != "stop":
-                    self._send(HTTPStatus.NOT_FOUND, b"not found\n", "text/plain")
-                    return
-                view.stop.request(f"Stop from the live view ({self.client_address[0]})")
-                self._send(HTTPStatus.OK, json.dumps({"stop_requested": True}).encode(), "application/json")
-
-        return Handler
 
 
 def _reply_text(reply: dp.Reply) -> str:

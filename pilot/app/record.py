@@ -5,14 +5,21 @@
   the state transitions and the result at the end.
 * ``path.png``: the room from above with the target, the distractors and the drone's path (simulated
   flights; a real flight has no position to draw).
+
+The recording is best effort: a full disk or any I/O error ends it with one line on stderr and the flight
+goes on (``record_failure: continue``, the default) or stops as after Stop, laser off, land, disarm
+(``record_failure: stop``); it never raises into the pilot's loop or the link.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import sys
+import tempfile
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import cv2
 import drone_protocol as dp
@@ -23,7 +30,7 @@ from ..common.errors import PilotError
 from ..link.serial_link import LogEntry
 from ..sim.scenario import Scenario
 from .overlay import annotate
-from .runner import Tick
+from .runner import StopRequested, Tick
 
 VIDEO = "flight.avi"
 LOG = "log.jsonl"
@@ -31,6 +38,10 @@ PATH_PICTURE = "path.png"
 
 
 RECORDING_FILES = (VIDEO, LOG, PATH_PICTURE)
+
+
+class RecordingFailed(StopRequested):
+    """The recording failed and the config says to stop the flight (``record_failure: stop``)."""
 
 
 def prepare_directory(directory: str | Path, force: bool = False) -> Path:
@@ -49,6 +60,8 @@ def prepare_directory(directory: str | Path, force: bool = False) -> Path:
         for name in existing:
             (path / name).unlink()
         path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):  # an existing folder may still be unwritable (a read-only disk)
+            pass
     except OSError as exc:
         raise PilotError(f"option --record: cannot write into {str(path)!r}: {exc.strerror or exc}") from exc
     return path
@@ -58,16 +71,45 @@ def _reply_text(reply: dp.Reply) -> str:
     return reply.kind.name + (reply.category or "") + (reply.direction or "") + (reply.error or "")
 
 
+def _open_log(path: Path) -> IO[str]:
+    return path.open("w", encoding="utf-8")
+
+
+def _warn(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
+
+
 class Recorder(Closing):
-    def __init__(self, directory: str | Path, fps: float = 20.0) -> None:
+    def __init__(
+        self,
+        directory: str | Path,
+        fps: float = 20.0,
+        *,
+        on_failure: str = "continue",
+        open_log: Callable[[Path], IO[str]] | None = None,
+        warn: Callable[[str], None] = _warn,
+    ) -> None:
         self.dir = Path(directory)
         self.dir.mkdir(parents=True, exist_ok=True)
         self.fps = fps
+        self.on_failure = on_failure
+        self._warn = warn
+        self.failed = ""  # why the recording ended early, if it did
         self._writer: cv2.VideoWriter | None = None
-        self._log = (self.dir / LOG).open("w", encoding="utf-8")
+        self._log = (open_log or _open_log)(self.dir / LOG)
         self._last_command = ""
         self._t0: float | None = None
         self._closed = False
+
+    def _fail(self, what: str, exc: BaseException) -> None:
+        """End the recording with one line; the files written so far stay."""
+        if self.failed:
+            return
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc) or type(exc).__name__
+        self.failed = f"{what}: {reason}"
+        then = "landing (record_failure: stop)" if self.on_failure == "stop" else "the flight goes on"
+        self._warn(f"pilot: recording stopped: {self.failed}; {then}")
+        self.close()
 
     @property
     def video_path(self) -> Path:
@@ -82,9 +124,13 @@ class Recorder(Closing):
         return self.dir / PATH_PICTURE
 
     def write(self, record: dict[str, Any]) -> None:
-        if not self._closed:
+        if self._closed:
+            return
+        try:
             self._log.write(json.dumps(record, sort_keys=True) + "\n")
             self._log.flush()  # a crash loses no line: the log is what is left to read afterwards
+        except (OSError, ValueError) as exc:
+            self._fail(str(self.log_path), exc)
 
     def _since_start(self, t: float) -> float:
         """Seconds from the first event recorded (the link opening or the first tick), whatever the clock's
@@ -97,6 +143,10 @@ class Recorder(Closing):
         self.write({"t": round(self._since_start(entry.t), 3), "link": entry.kind, "data": entry.data})
 
     def on_tick(self, tick: Tick) -> None:
+        if self.failed and self.on_failure == "stop":
+            raise RecordingFailed(f"the recording failed ({self.failed})")
+        if self._closed:
+            return
         det = tick.detection
         if tick.command is not None:
             self._last_command = tick.command.decode("ascii", "replace")
@@ -120,17 +170,24 @@ class Recorder(Closing):
                 "replies": [_reply_text(r) for r in tick.replies],
             }
         )
-        if tick.frame is not None:
-            self._video(tick)
+        if tick.frame is not None and not self._closed:
+            try:
+                self._video(tick)
+            except (OSError, cv2.error) as exc:
+                self._fail(str(self.video_path), exc)
 
     def _video(self, tick: Tick) -> None:
         img = annotate(tick, self._since_start(tick.t), self._last_command)
         if self._writer is None:
             h, w = img.shape[:2]
             self._writer = cv2.VideoWriter(str(self.video_path), cv2.VideoWriter.fourcc(*"MJPG"), self.fps, (w, h))
+            if not self._writer.isOpened():
+                raise OSError(0, "cannot open the video for writing")
         self._writer.write(img)
 
-    def path_png(self, scenario: Scenario, path: list[tuple[float, float, float, float]], scale: int = 60) -> Path:
+    def path_png(
+        self, scenario: Scenario, path: list[tuple[float, float, float, float]], scale: int = 60
+    ) -> Path | None:
         """The room from above: walls, target (red), distractors, start (green) and the path (blue)."""
         room = scenario.room
         margin = 20
@@ -158,14 +215,26 @@ class Recorder(Closing):
         cv2.putText(
             img, f"{room.width:g} x {room.depth:g} m", (margin, h - 5), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (90, 90, 90), 1
         )
-        cv2.imwrite(str(self.path_picture), img)
+        if self.failed:
+            return None
+        try:
+            if not cv2.imwrite(str(self.path_picture), img):
+                raise OSError(0, "cannot write the picture")
+        except (OSError, cv2.error) as exc:
+            self._fail(str(self.path_picture), exc)
+            return None
         return self.path_picture
 
     def close(self) -> None:
         if self._closed:
             return
         self._closed = True
-        if self._writer is not None:
-            self._writer.release()
-        self._log.close()
+        try:
+            if self._writer is not None:
+                self._writer.release()
+        finally:
+            try:
+                self._log.close()
+            except (OSError, ValueError) as exc:  # the last flush: the disk filled since
+                self._fail(str(self.log_path), exc)
 

@@ -174,7 +174,9 @@ def fly(
     scenario = make_scenario(scenario_name, seed, noise=noise, max_wind=max_wind, gusts=gusts, ideal=ideal)
     # a flight is deterministic for its seed: the detector's budget counts simulated time, in which a look takes none
     detector = make_detector(cfg, clock=lambda: 0.0)
-    recorder = Recorder(record_dir, fps=cfg.link.rate_hz) if record_dir is not None else None
+    recorder = None
+    if record_dir is not None:
+        recorder = Recorder(record_dir, fps=cfg.link.rate_hz, on_failure=cfg.record_failure)
     wall0 = time.perf_counter()
     tick_ms = round(1000.0 / cfg.link.rate_hz)
     try:
@@ -215,7 +217,8 @@ def fly(
             state = world.state
             picture = None
             if recorder is not None:
-                picture = str(recorder.path_png(scenario, score.path))
+                drawn = recorder.path_png(scenario, score.path)
+                picture = str(drawn) if drawn is not None else None
                 recorder.write(
                     {
                         "result": {

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import reprlib
 import types
 import typing
 from dataclasses import dataclass, field
@@ -124,49 +125,66 @@ class PilotConfig:
     aruco: ArucoConfig = field(default_factory=ArucoConfig)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     link: LinkConfig = field(default_factory=LinkConfig)
+    record_failure: str = "continue"  # --record's disk failed: "continue" the flight, or "stop" it (land, disarm)
 
 
 DETECTORS = ("hsv", "aruco")
+RECORD_FAILURES = ("continue", "stop")
 
 T = TypeVar("T")
+
+MAX_INT = 2**53  # no option comes near; beyond, comparisons with floats would overflow
+_REPR = reprlib.Repr()
+_REPR.maxstring = _REPR.maxother = _REPR.maxlong = 60
+_REPR.maxlevel = 3
+
+
+def _show(value: Any) -> str:
+    """A value in a message: on one line and short, whatever the file held (a 10 MB string, a deep list)."""
+    return _REPR.repr(value)
 
 
 def _convert(value: Any, tp: Any, path: str, where: str) -> Any:
     origin = typing.get_origin(tp)
     if dataclasses.is_dataclass(tp) and isinstance(tp, type):
         if not isinstance(value, dict):
-            raise ConfigError(f"{where}: option {path!r} must be a mapping, got {value!r}")
+            raise ConfigError(f"{where}: option {_show(path)} must be a mapping, got {_show(value)}")
         return _build(tp, value, path, where)
     if tp is bool:
         if not isinstance(value, bool):
-            raise ConfigError(f"{where}: option {path!r} must be true or false, got {value!r}")
+            raise ConfigError(f"{where}: option {_show(path)} must be true or false, got {_show(value)}")
         return value
     if tp is int:
         if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f"{where}: option {path!r} must be an integer, got {value!r}")
+            raise ConfigError(f"{where}: option {_show(path)} must be an integer, got {_show(value)}")
+        if abs(value) > MAX_INT:
+            raise ConfigError(f"{where}: option {_show(path)} is too large a number: {_show(value)}")
         return value
     if tp is float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ConfigError(f"{where}: option {path!r} must be a number, got {value!r}")
-        return float(value)
+            raise ConfigError(f"{where}: option {_show(path)} must be a number, got {_show(value)}")
+        try:
+            return float(value)
+        except OverflowError as exc:
+            raise ConfigError(f"{where}: option {_show(path)} is too large a number: {_show(value)}") from exc
     if tp is str:
         if not isinstance(value, str):
-            raise ConfigError(f"{where}: option {path!r} must be a string, got {value!r}")
+            raise ConfigError(f"{where}: option {_show(path)} must be a string, got {_show(value)}")
         return value
     if origin is tuple:
         args = typing.get_args(tp)
         if not isinstance(value, (list, tuple)):
-            raise ConfigError(f"{where}: option {path!r} must be a list, got {value!r}")
+            raise ConfigError(f"{where}: option {_show(path)} must be a list, got {_show(value)}")
         if len(args) == 2 and args[1] is Ellipsis:
             return tuple(_convert(v, args[0], f"{path}[{i}]", where) for i, v in enumerate(value))
         if len(value) != len(args):
             raise ConfigError(
-                f"{where}: option {path!r} must have {len(args)} items, got {len(value)}: {value!r}"
+                f"{where}: option {_show(path)} must have {len(args)} items, got {len(value)}: {_show(value)}"
             )
         return tuple(_convert(v, a, f"{path}[{i}]", where) for i, (v, a) in enumerate(zip(value, args, strict=False)))
     if isinstance(tp, types.UnionType):  # pragma: no cover - not used by the config today
-        raise ConfigError(f"{where}: option {path!r} has an unsupported type")
-    raise ConfigError(f"{where}: option {path!r} has an unsupported type {tp!r}")
+        raise ConfigError(f"{where}: option {_show(path)} has an unsupported type")
+    raise ConfigError(f"{where}: option {_show(path)} has an unsupported type {tp!r}")
 
 
 def _build(cls: type[T], data: dict[str, Any], prefix: str, where: str) -> T:
@@ -176,7 +194,7 @@ def _build(cls: type[T], data: dict[str, Any], prefix: str, where: str) -> T:
         if key not in names:
             path = f"{prefix}.{key}" if prefix else str(key)
             raise ConfigError(
-                f"{where}: unknown option {path!r}; known options here: {', '.join(sorted(names))}"
+                f"{where}: unknown option {_show(path)}; known options here: {', '.join(sorted(names))}"
             )
     kwargs = {
         key: _convert(value, hints[key], f"{prefix}.{key}" if prefix else key, where)
@@ -232,14 +250,18 @@ def _check_ranges(config: PilotConfig, where: str) -> None:
     for path, (low, high) in RANGES.items():
         value = _option(config, path)
         if not (math.isfinite(value) and low <= value <= high):  # NaN and infinities fail here
-            raise ConfigError(f"{where}: option {path!r} must be within {low:g}..{high:g}, got {value!r}")
+            raise ConfigError(f"{where}: option {_show(path)} must be within {low:g}..{high:g}, got {_show(value)}")
 
 
 def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
     """Check value ranges; raise ConfigError naming the option."""
     _check_ranges(config, where)
     if config.detector not in DETECTORS:
-        raise ConfigError(f"{where}: option 'detector' must be one of {DETECTORS}, got {config.detector!r}")
+        raise ConfigError(f"{where}: option 'detector' must be one of {DETECTORS}, got {_show(config.detector)}")
+    if config.record_failure not in RECORD_FAILURES:
+        raise ConfigError(
+            f"{where}: option 'record_failure' must be one of {RECORD_FAILURES}, got {_show(config.record_failure)}"
+        )
     for i, (lo, hi) in enumerate(config.hsv.ranges):
         for name, triple in (("low", lo), ("high", hi)):
             h, s, v = triple
@@ -270,7 +292,7 @@ def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
 
 def _in(where: str, option: str, value: float, lo: float, hi: float) -> None:
     if not lo <= value <= hi:
-        raise ConfigError(f"{where}: option {option!r} must be within {lo:g}..{hi:g}, got {value!r}")
+        raise ConfigError(f"{where}: option {option!r} must be within {lo:g}..{hi:g}, got {_show(value)}")
 
 
 def _validate_vision(config: PilotConfig, where: str) -> None:
@@ -298,16 +320,51 @@ def from_dict(data: dict[str, Any], where: str = "config") -> PilotConfig:
     return validate(_build(PilotConfig, data, "", where), where)
 
 
+MAX_CONFIG_BYTES = 1_000_000  # a config is a few kilobytes; this bounds what a wrong file can cost
+
+
+def _read_text(path: Path, where: str) -> str:
+    try:
+        with path.open("rb") as f:
+            raw = f.read(MAX_CONFIG_BYTES + 1)
+    except OSError as exc:
+        raise ConfigError(f"{where}: cannot read config: {exc.strerror or exc}") from exc
+    if len(raw) > MAX_CONFIG_BYTES:
+        raise ConfigError(f"{where}: config larger than {MAX_CONFIG_BYTES:,} bytes: is it the right file?")
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")) or raw[:2].count(0) == 1:
+        raise ConfigError(f"{where}: the config is saved as UTF-16: save it as UTF-8")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise ConfigError(
+            f"{where}:{line}: the config is not UTF-8 (byte 0x{raw[exc.start]:02x}, perhaps Latin-1 or "
+            "Windows-1252): save it as UTF-8"
+        ) from exc
+
+
+def _yaml_problem(exc: yaml.YAMLError) -> str:
+    """A YAML error on one line: line:column: problem."""
+    if isinstance(exc, yaml.MarkedYAMLError):
+        mark = exc.problem_mark or exc.context_mark
+        problem = " ".join(str(x) for x in (exc.context, exc.problem) if x)
+        where = f"{mark.line + 1}:{mark.column + 1}: " if mark is not None else ""
+        return f"{where}not valid YAML: {' '.join(problem.split())}"
+    return f"not valid YAML: {' '.join(str(exc).split())}"
+
+
 def load(path: str | Path) -> PilotConfig:
     where = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ConfigError(f"{where}: cannot read config: {exc.strerror}") from exc
+    text = _read_text(Path(path), where)
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
-        raise ConfigError(f"{where}: not valid YAML: {exc}") from exc
+        raise ConfigError(f"{where}:{_yaml_problem(exc)}" if isinstance(exc, yaml.MarkedYAMLError)
+                          else f"{where}: {_yaml_problem(exc)}") from exc
+    except RecursionError as exc:
+        raise ConfigError(f"{where}: not valid YAML: nested too deep for a config") from exc
+    except ValueError as exc:  # an integer of thousands of digits, a bad timestamp
+        raise ConfigError(f"{where}: not valid YAML: {' '.join(str(exc).split())[:160]}") from exc
     if data is None:
         data = {}
     if not isinstance(data, dict):

@@ -17,6 +17,7 @@ The link is a context manager; ``close()`` is safe to call twice.
 from __future__ import annotations
 
 import contextlib
+import sys
 import time
 from collections import deque
 from collections.abc import Callable
@@ -30,6 +31,7 @@ from ..common.closing import Closing
 from ..common.errors import FingerprintMismatch, LinkError, PortLost, ReadyTimeout
 
 MAX_LINE = 128
+LOG_HISTORY = 2000  # the link's own log: the latest entries (about 50 s of traffic at 20 Hz)
 
 
 @dataclass(frozen=True)
@@ -93,7 +95,8 @@ class Link(Closing):
         # waits for the kernel there, not for simulated time
         self._ready_clock = ready_clock or clock
         self._ready_sleep = ready_sleep or sleep
-        self._log = log
+        self._log = log  # a subscriber (the recorder): its failure never reaches the link's caller
+        self.log: deque[LogEntry] = deque(maxlen=LOG_HISTORY)  # the link's own log, bounded
         # called after every (re)opening of the port, before the ready-line wait: the simulator runs
         # the virtual board's reboot there (opening the port resets it, as DTR resets an Uno)
         self._on_open = on_open
@@ -117,8 +120,15 @@ class Link(Closing):
         return str(getattr(self._port, "port", None) or self._port)
 
     def _note(self, kind: str, data: str) -> None:
+        entry = LogEntry(self._clock(), kind, data)
+        self.log.append(entry)
         if self._log is not None:
-            self._log(LogEntry(self._clock(), kind, data))
+            try:
+                self._log(entry)
+            except Exception as exc:  # the link carries on; its own log keeps the traffic
+                self._log = None
+                print(f"pilot: the link's log subscriber failed ({type(exc).__name__}: {exc}); "
+                      "the link goes on without it", file=sys.stderr, flush=True)
 
     # -- opening ----------------------------------------------------------------------------------
     def _open_port(self) -> None:

@@ -60,7 +60,7 @@ def test_check_writes_nothing_and_fails_naming_every_stale_file_after_a_spec_edi
     # A description is printed in every target, and the fingerprint in every header: every file is stale.
     stale = sorted(line for line in run.stdout.splitlines() if line)
     assert stale == sorted(f"stale: {out / rel}" for rel in before)
-    assert f"{len(before)} generated file(s) out of date: run `python -m generator`" in run.stderr
+    assert f"{len(before)} generated file(s) out of date or left over: run `python -m generator`" in run.stderr
 
 
 def test_check_names_a_missing_file(tmp_path: Path) -> None:

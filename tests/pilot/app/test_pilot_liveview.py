@@ -6,7 +6,6 @@ from __future__ import annotations
 import json
 import os
 import queue
-import shutil
 import subprocess
 import sys
 import threading
@@ -17,9 +16,8 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from browser_rig import browser_session
 from selenium import webdriver
-from selenium.webdriver.chrome.options import Options
-from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.by import By
 
 from pilot.app.liveview import LiveView, parse_address
@@ -27,29 +25,11 @@ from pilot.app.observers import StopSwitch
 from pilot.common.errors import PilotError
 
 REPO = Path(__file__).resolve().parents[3]
-CHROMIUM, CHROMEDRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
-CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                  "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                  "--window-size=1200,900")
-
-
-def chromium(profile: Path) -> webdriver.Chrome:
-    assert Path(CHROMIUM).is_file() and Path(CHROMEDRIVER).is_file(), "make deps installs chromium + chromium-driver"
-    options = Options()
-    options.binary_location = CHROMIUM
-    for flag in (*CHROMIUM_FLAGS, f"--user-data-dir={profile}"):
-        options.add_argument(flag)
-    return webdriver.Chrome(options=options, service=Service(executable_path=CHROMEDRIVER))
 
 
 @pytest.fixture
 def browser(tmp_path: Path) -> Iterator[webdriver.Chrome]:
-    driver = chromium(tmp_path / "chromium-profile")
-    try:
-        yield driver
-    finally:
-        driver.quit()
-        shutil.rmtree(tmp_path / "chromium-profile", ignore_errors=True)
+    yield from browser_session(tmp_path)
 
 
 class Pilot:
