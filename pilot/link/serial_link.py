@@ -21,13 +21,16 @@ import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Self
+from typing import TYPE_CHECKING, Any
 
 import drone_protocol as dp
 import serial
 
 from ..common.closing import Closing
 from ..common.errors import FingerprintMismatch, LinkError, PortLost, ReadyTimeout
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
 
 MAX_LINE = 128
 

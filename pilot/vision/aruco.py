@@ -82,7 +82,7 @@ class ArucoMarkerDetector:
         if ids is None or len(corners) == 0:
             return []
         found = []
-        for quad, marker in zip(corners, np.asarray(ids).reshape(-1), strict=True):
+        for quad, marker in zip(corners, np.asarray(ids).reshape(-1)):
             if self.marker_id >= 0 and int(marker) != self.marker_id:
                 continue
             pts = np.asarray(quad, dtype=np.float64).reshape(4, 2) * scale
