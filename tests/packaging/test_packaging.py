@@ -13,6 +13,7 @@ import zipfile
 from pathlib import Path
 
 import drone_protocol as dp
+import make_dist
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -88,21 +89,19 @@ def test_the_codec_wheel_installs_and_imports_in_a_fresh_venv_with_nothing_else(
 
 
 def test_the_project_wheel_installs_one_namespace_of_its_own(tmp_path: Path) -> None:
-    src = tmp_path / "project"
-    src.mkdir()
-    for name in ("pyproject.toml", "setup.py", "README.md", "LICENSE", "generator", "pilot"):
-        path = ROOT / name
-        if path.is_dir():
-            shutil.copytree(path, src / name, ignore=shutil.ignore_patterns("__pycache__"))
-        else:
-            shutil.copy(path, src / name)
-    wheel = _wheel(src, tmp_path)
+    wheel = _wheel(make_dist.copy_tools_source(tmp_path / "project"), tmp_path)
     with zipfile.ZipFile(wheel) as zf:
         names = zf.namelist()
     tops = {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")}
     assert tops == {"drone_protocol_tools"}
     assert "drone_protocol_tools/generator/cli.py" in names and "drone_protocol_tools/pilot/app/cli.py" in names
     assert any(n.startswith("drone_protocol_tools/generator/templates/python/") for n in names)
+    # package data: the simulator's parameters and the virtual drone's sources (nothing read from the repository)
+    assert {"drone_protocol_tools/pilot/sim/arducopter.yaml", "drone_protocol_tools/pilot/sim/drone.parm",
+            "drone_protocol_tools/pilot/sim/firmware/host/virtual_drone.cpp"} <= set(names)
+    meta = _metadata(wheel)
+    assert re.search(r"^Requires-Python: >=3\.9$", meta, re.M)
+    assert "Project-URL" not in meta and "Home-page" not in meta  # no placeholder: there is no public URL
     assert re.search(rf"^Requires-Dist: {dp.PROTOCOL_NAME.replace('_', '-')}$", _metadata(wheel), re.M)
 
 
