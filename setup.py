@@ -41,6 +41,6 @@ class BuildWithFirmware(build_py):
 setup(
     packages=[f"{NAMESPACE}.{p}" for p in found],
     package_dir={f"{NAMESPACE}.{p}": p.replace(".", "/") for p in found},
-    package_data={f"{NAMESPACE}.{p}": ["py.typed", "*.j2", "**/*.j2", "*.html", "*.yaml"] for p in found},
+    package_data={f"{NAMESPACE}.{p}": ["py.typed", "*.j2", "**/*.j2", "*.html", "*.yaml", "LICENSE"] for p in found},
     cmdclass={"build_py": BuildWithFirmware},
 )

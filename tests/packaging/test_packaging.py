@@ -8,6 +8,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tomllib
 import venv
 import zipfile
 from pathlib import Path
@@ -21,8 +22,9 @@ CODEC = ROOT / "generated" / "python"
 BIN = Path(sys.executable).parent
 
 
-def _run(*cmd: str | Path, cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess[str]:
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+def _run(*cmd: str | Path, cwd: Path, timeout: float = 300,
+         env_extra: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")} | (env_extra or {})
     return subprocess.run([str(c) for c in cmd], cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
 
 
@@ -61,6 +63,10 @@ def test_the_codec_wheel_holds_the_package_alone(codec_wheel: Path) -> None:
     assert re.search(r"^Requires-Python: >=3\.9$", meta, re.M)
     assert "Requires-Dist" not in meta
     assert dp.SPEC_FINGERPRINT in meta  # the README is the long description
+    assert re.search(r"^License-Expression: MIT$", meta, re.M) and "Project-URL" not in meta
+    with zipfile.ZipFile(codec_wheel) as zf:
+        licence = zf.read(f"{dp.PROTOCOL_NAME}-{dp.__version__}.dist-info/licenses/LICENSE")
+    assert licence == (ROOT / "LICENSE").read_bytes()
 
 
 def test_the_codec_wheel_installs_and_imports_in_a_fresh_venv_with_nothing_else(
@@ -126,3 +132,16 @@ def test_the_console_scripts_outside_the_repo(tmp_path: Path) -> None:
     assert with_spec.returncode == 0 and dp.SPEC_FINGERPRINT in with_spec.stdout
     pilot = _run(BIN / "pilot", "--version", cwd=tmp_path)
     assert pilot.returncode == 0 and dp.SPEC_FINGERPRINT in pilot.stdout, pilot.stdout + pilot.stderr
+
+
+def test_the_crate_package_holds_its_readme_and_license_with_complete_metadata(tmp_path: Path) -> None:
+    crate = ROOT / "generated" / "rust"
+    listed = _run("cargo", "package", "--list", "--locked", "--offline", "--allow-dirty", cwd=crate,
+                  env_extra={"CARGO_TARGET_DIR": str(tmp_path)})
+    assert listed.returncode == 0, listed.stderr
+    assert {"Cargo.toml", "README.md", "LICENSE"} <= set(listed.stdout.split())
+    # cargo's "manifest has no documentation, homepage or repository" warning is gone
+    assert "warning: manifest has no" not in listed.stderr, listed.stderr
+    package = tomllib.loads((crate / "Cargo.toml").read_text(encoding="utf-8"))["package"]
+    assert package["documentation"] == f"https://docs.rs/{package['name']}"
+    assert "homepage" not in package and "repository" not in package  # none public: no placeholder
