@@ -126,6 +126,12 @@ def test_the_console_scripts_outside_the_repo(tmp_path: Path) -> None:
     gen = _run(BIN / "drone-protocol-gen", cwd=tmp_path)
     assert gen.returncode == 2 and not (tmp_path / "generated").exists()
     assert gen.stderr.count("\n") == 1 and "pass --spec FILE" in gen.stderr, gen.stderr
+    helped = _run(BIN / "drone-protocol-gen", "--help", cwd=tmp_path)
+    assert helped.returncode == 0 and "python -m generator" not in helped.stdout, helped.stdout
+    assert helped.stdout.startswith("usage: drone-protocol-gen [-h]")
+    assert "  drone-protocol-gen diff OLD [NEW]" in helped.stdout
+    diff_help = _run(BIN / "drone-protocol-gen", "diff", "--help", cwd=tmp_path)
+    assert diff_help.stdout.startswith("usage: drone-protocol-gen diff"), diff_help.stdout
     version = _run(BIN / "drone-protocol-gen", "--version", cwd=tmp_path)
     assert version.returncode == 0 and "no spec" in version.stdout
     with_spec = _run(BIN / "drone-protocol-gen", "--version", "--spec", ROOT / "spec" / "drone.yaml", cwd=tmp_path)
