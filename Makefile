@@ -17,7 +17,7 @@ APT_PACKAGES := make gcc g++ python3 python3-venv python3-pip gcc-avr binutils-a
                 simavr libsimavr-dev libelf-dev pkg-config clang libclang-rt-14-dev valgrind \
                 chromium chromium-driver libosmesa6 libgl1-mesa-dri libegl1
 
-.PHONY: all demo test deps generate check-generated lint typecheck pytest fuzz fuzz-smoke bench clean
+.PHONY: all demo test deps generate check-generated lint typecheck pytest fuzz fuzz-smoke bench clean dist pythons
 
 all: generate
 
@@ -58,7 +58,15 @@ lint: $(VENV_STAMP)
 typecheck: $(VENV_STAMP)
 	$(VENV)/bin/mypy --strict generator generated/python/drone_protocol pilot tests bench firmware/ide
 
-pytest: deps
+# tests/packaging/test_install.py installs the wheels on the oldest and the newest Python supported
+INSTALL_TEST_PYTHONS := 3.9 3.13
+
+pythons:
+	@for v in $(INSTALL_TEST_PYTHONS); do command -v python$$v >/dev/null || ls -d $${PYENV_ROOT:-$$HOME/.pyenv}/versions/$$v.* \
+	  >/dev/null 2>&1 || { command -v pyenv >/dev/null && pyenv install -s $$v; } || \
+	  { echo "Python $$v is missing: install pyenv (https://github.com/pyenv/pyenv) and run  pyenv install $$v"; exit 1; }; done
+
+pytest: deps pythons
 	$(PY) -m pytest -q -n 2 --dist loadgroup tests
 
 test: deps check-generated lint typecheck pytest fuzz-smoke
@@ -74,5 +82,16 @@ demo: deps generate
 -include tests/targets/targets.mk
 -include tests/targets/typescript.mk
 
+# Every package into dist/: the codec's and the tools' wheels, the npm tarball and the crate.
+DIST := dist
+dist: $(VENV_STAMP) $(TS_STAMP) cargo-available
+	@rm -rf $(DIST) && mkdir -p $(DIST)
+	$(PY) tests/packaging/make_dist.py $(DIST)
+	cp $(TS_BUILD)/*.tgz $(DIST)/
+	@rm -f build/rust/target/package/*.crate
+	$(CARGO_RUN) package $(CARGO_FLAGS) --allow-dirty --no-verify --quiet
+	cp build/rust/target/package/*.crate $(DIST)/
+	@ls -l $(DIST)
+
 clean:
-	rm -rf build firmware/build
+	rm -rf build firmware/build dist

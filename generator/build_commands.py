@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import difflib
-from typing import TypeVar
+from typing import Optional, TypeVar
 
 from .errors import SpecError
 from .model import Category, Channel, Direction, Field, Servo
@@ -14,7 +14,7 @@ from .source import Node
 
 T = TypeVar("T")
 SPEED_LABELS = ("low", "median", "high")
-FieldEntry = tuple[Field, tuple[int, int] | None, int | None, Node]
+FieldEntry = tuple[Field, Optional[tuple[int, int]], Optional[int], Node]
 
 
 class CommandsBuilder:

@@ -23,13 +23,20 @@ EXIT_INVALID = 2
 CONTRACT_FILE = "contract.json"
 # Relative to the current folder: the repository's layout. An installed generator run elsewhere needs --spec.
 DEFAULT_SPEC = Path("spec/drone.yaml")
+INSTALLED = "drone-protocol-gen"  # the console script of the tools' distribution (pyproject.toml)
+
+
+def program() -> str:
+    """How the user ran the generator: the installed command, or the module in the repository."""
+    return INSTALLED if Path(sys.argv[0]).name == INSTALLED else "python -m generator"
 
 
 def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else argv
     if args[:1] == ["diff"]:
         return diff_main(args[1:])
-    parser = argparse.ArgumentParser(prog="python -m generator", description=__doc__,
+    prog = program()
+    parser = argparse.ArgumentParser(prog=prog, description=(__doc__ or "").replace("python -m generator", prog),
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--spec", type=Path, help=f"the YAML spec (default: {DEFAULT_SPEC} in the current folder)")
     parser.add_argument("--out", type=Path, default=Path("generated"), help="output folder (default: %(default)s)")
@@ -74,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
         for line in problems:
             print(line)
         if problems:
-            print(f"{len(problems)} generated file(s) out of date or left over: run `python -m generator`",
+            print(f"{len(problems)} generated file(s) out of date or left over: run `{parser.prog}`",
                   file=sys.stderr)
             return EXIT_STALE
         print(f"{len(files)} generated files match {shown} (fingerprint {spec.short_fingerprint})")
@@ -93,7 +100,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def diff_main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m generator diff",
+        prog=f"{program()} diff",
         description="List what changed between two versions of the protocol; exit 1 if a change breaks a peer "
                     "built from OLD, 2 if a spec is invalid.")
     parser.add_argument("old", type=Path, help="the old spec, or a generated contract.json")

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import keyword
+import pkgutil
 import re
 import sys
+import sysconfig
 from pathlib import Path
 
 IDENTIFIER = re.compile(r"^[a-z][a-z0-9]*(_[a-z0-9]+)*$")
@@ -44,7 +46,12 @@ MAX_NAME = 40  # a name becomes a file name, a C++ macro prefix and a Python ide
 # The protocol's name is also a Python package (it must not shadow a standard module: `import os` would
 # load the generated codec), a C++ namespace and, in PascalCase, an Arduino library and its header file
 # (it must not replace the core's or a bundled library's header).
-PROTOCOL_RESERVED = frozenset(sys.stdlib_module_names) | frozenset(
+if sys.version_info >= (3, 10):
+    STDLIB_MODULES = frozenset(sys.stdlib_module_names)
+else:  # Python 3.9: the modules in the standard library's folders and those built into the interpreter
+    _STDLIB_DIRS = [sysconfig.get_path("stdlib"), str(Path(sysconfig.get_path("platstdlib")) / "lib-dynload")]
+    STDLIB_MODULES = frozenset(m.name for m in pkgutil.iter_modules(_STDLIB_DIRS)) | frozenset(sys.builtin_module_names)
+PROTOCOL_RESERVED = STDLIB_MODULES | frozenset(
     """std posix detail arduino eeprom hid keyboard mouse servo software_serial spi wire stepper ethernet sd
     generator pilot drone_sim""".split()
 )

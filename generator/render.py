@@ -35,8 +35,8 @@ def header_lines(spec: Spec) -> list[str]:
 def _with_header(path: str, text: str, spec: Spec) -> str:
     lines = header_lines(spec)
     style = comment_style(path)
-    if style == "json":
-        return text  # JSON has no comments: its template prints the header as its first member
+    if style in ("json", ""):
+        return text  # JSON has no comments: its template prints the header as its first member; LICENSE has none
     if style == "<!--":
         return "<!--\n" + "\n".join(lines) + "\n-->\n" + text
     return "".join(f"{style} {line}\n" for line in lines) + text
@@ -116,6 +116,8 @@ def render_all(spec: Spec) -> dict[str, bytes]:
         "reply_max_length": spec.reply_max_length,
         "contract_json": json.dumps(contract(spec), indent=2, sort_keys=True).replace("\n", "\n  "),
         "ctype": CTYPES,
+        # the project's license, in every package (templates/LICENSE is the repository's LICENSE, a test keeps it so)
+        "license_text": (TEMPLATES / "LICENSE").read_text(encoding="utf-8"),
     }
     files: dict[str, bytes] = {}
     for target in TARGETS:

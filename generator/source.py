@@ -16,6 +16,7 @@ import os
 import stat
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Union
 
 import yaml
 
@@ -87,7 +88,7 @@ class Invalid:
 
 INVALID = Invalid()
 
-Plain = None | bool | int | float | str | list["Plain"] | dict[str, "Plain"] | Invalid
+Plain = Union[None, bool, int, float, str, list["Plain"], dict[str, "Plain"], Invalid]
 
 
 @dataclass

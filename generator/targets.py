@@ -35,6 +35,7 @@ TARGETS: tuple[Target, ...] = (
 COMMENT_BY_NAME = {
     "keywords.txt": "#",  # the Arduino IDE skips lines starting with '#'
     "py.typed": "#",
+    "LICENSE": "",  # no header: license checkers (crates.io, licensee, npm) read the text as written
 }
 COMMENT_BY_SUFFIX = {
     ".properties": "#",  # Arduino's library.properties: '#' is the only comment its parsers accept
@@ -61,7 +62,7 @@ COMMENT_BY_SUFFIX = {
 def comment_style(path: str) -> str:
     """The header style of the generated file at `path`; a format nobody taught us is an error, not a guess."""
     p = PurePosixPath(path)
-    style = COMMENT_BY_NAME.get(p.name) or COMMENT_BY_SUFFIX.get(p.suffix)
+    style = COMMENT_BY_NAME[p.name] if p.name in COMMENT_BY_NAME else COMMENT_BY_SUFFIX.get(p.suffix)
     if style is None:
         raise ValueError(f"no comment syntax known for generated file '{path}': add its name or suffix to "
                          "COMMENT_BY_NAME / COMMENT_BY_SUFFIX in generator/targets.py")

@@ -8,7 +8,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import reprlib
-import types
 import typing
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -181,9 +180,7 @@ def _convert(value: Any, tp: Any, path: str, where: str) -> Any:
             raise ConfigError(
                 f"{where}: option {_show(path)} must have {len(args)} items, got {len(value)}: {_show(value)}"
             )
-        return tuple(_convert(v, a, f"{path}[{i}]", where) for i, (v, a) in enumerate(zip(value, args, strict=False)))
-    if isinstance(tp, types.UnionType):  # pragma: no cover - not used by the config today
-        raise ConfigError(f"{where}: option {_show(path)} has an unsupported type")
+        return tuple(_convert(v, a, f"{path}[{i}]", where) for i, (v, a) in enumerate(zip(value, args)))
     raise ConfigError(f"{where}: option {_show(path)} has an unsupported type {tp!r}")
 
 
@@ -269,7 +266,7 @@ def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
                 raise ConfigError(
                     f"{where}: option 'hsv.ranges[{i}]' {name} {triple} out of range (H 0..179, S,V 0..255)"
                 )
-        for channel, low, high in zip("HSV", lo, hi, strict=True):
+        for channel, low, high in zip("HSV", lo, hi):
             if low > high:  # inRange would match nothing: the detector would never see the target
                 wraps = " (a hue range across 179 is two ranges: [174..179] and [0..6])" if channel == "H" else ""
                 raise ConfigError(f"{where}: option 'hsv.ranges[{i}]' low {lo} is above high {hi} in {channel}{wraps}")

@@ -22,13 +22,16 @@ import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Self
+from typing import TYPE_CHECKING, Any
 
 import drone_protocol as dp
 import serial
 
 from ..common.closing import Closing
 from ..common.errors import FingerprintMismatch, LinkError, PortLost, ReadyTimeout
+
+if TYPE_CHECKING:
+    from typing_extensions import Self
 
 MAX_LINE = 128
 LOG_HISTORY = 2000  # the link's own log: the latest entries (about 50 s of traffic at 20 Hz)

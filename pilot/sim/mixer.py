@@ -31,16 +31,16 @@ class Mixer:
         """Motor thrusts (N) for a collective force (N) and body torques (N m, FLU)."""
         span = self._span
         throttle = min(max(force / self._n - self._floor, 0.0), span)  # above the armed floor
-        rp = [r * roll + p * pitch for r, p in zip(self._roll, self._pitch, strict=True)]
+        rp = [r * roll + p * pitch for r, p in zip(self._roll, self._pitch)]
         # the yaw that fits around roll and pitch with the throttle at its best point for attitude
         best = min(span / 2.0, throttle)
         room = float("inf")
-        for share, y in zip(rp, self._yaw, strict=True):
+        for share, y in zip(rp, self._yaw):
             up = span - (best + share) if y * yaw > 0.0 else best + share
             room = min(room, max(up, 0.0) / abs(y))
         room = max(room, self._yaw_min / abs(self._yaw[0]))
         yaw = min(max(yaw, -room), room)
-        out = [share + yaw * y for share, y in zip(rp, self._yaw, strict=True)]
+        out = [share + yaw * y for share, y in zip(rp, self._yaw)]
         low, high = min(out), max(out)
         scale = 1.0
         if high - low > span:

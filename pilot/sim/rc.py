@@ -26,7 +26,9 @@ from .randomise import Effects
 
 HERE = Path(__file__).resolve().parent
 PARAMS_YAML = HERE / "arducopter.yaml"
-REPO_PARM = HERE.parents[1] / "generated" / "ardupilot" / "arducopter-4" / "drone.parm"
+# in the repository, the generated file; installed from a wheel, the copy setup.py put beside this module
+REPO_PARM = next((p for p in (HERE / "drone.parm", HERE.parents[1] / "generated" / "ardupilot" / "arducopter-4" /
+                  "drone.parm") if p.is_file()), HERE / "drone.parm")
 STICKS = (dp.ChannelName.ROLL, dp.ChannelName.PITCH, dp.ChannelName.THROTTLE, dp.ChannelName.YAW)
 MODE_SLOT_BOUNDS_US = (1230, 1360, 1490, 1620, 1749)  # ArduPilot's read_6pos_switch
 ANGLE_RANGE = 4500.0

@@ -22,6 +22,7 @@ from typing import IO, Any
 
 from ..common.closing import Closing
 from ..common.errors import SimulatorError
+from . import drone_build
 
 _TYPES: dict[Any, Any] = {"int": int, "float": float, "bool": bool, int: int, float: float, bool: bool}
 REPO = Path(__file__).resolve().parents[2]
@@ -30,7 +31,10 @@ ENV_VAR = "PILOT_VIRTUAL_DRONE"
 
 
 def find_executable(explicit: str | Path | None = None) -> Path:
-    """The virtual drone: the explicit path, else $PILOT_VIRTUAL_DRONE, else the firmware's host build."""
+    """The virtual drone: the explicit path, else $PILOT_VIRTUAL_DRONE, else the firmware's host build; installed
+    from a wheel (no repository), the one built from the sources the package carries."""
+    if not explicit and not os.environ.get(ENV_VAR) and not DEFAULT_EXE.is_file() and drone_build.PACKAGED.is_dir():
+        return drone_build.build()
     candidate = Path(explicit) if explicit else Path(os.environ.get(ENV_VAR) or DEFAULT_EXE)
     if not (candidate.is_file() and os.access(candidate, os.X_OK)):
         raise SimulatorError(

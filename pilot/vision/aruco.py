@@ -95,7 +95,7 @@ class ArucoMarkerDetector:
         corners, ids, _ = self._detector(max(grey.shape[:2])).detectMarkers(grey)
         if ids is None or len(corners) == 0:
             return []
-        quads = [q for q, m in zip(corners, np.asarray(ids).reshape(-1), strict=True)
+        quads = [q for q, m in zip(corners, np.asarray(ids).reshape(-1))
                  if self.marker_id < 0 or int(m) == self.marker_id]
         return self._placed(quads, scale, width, 1.0)
 

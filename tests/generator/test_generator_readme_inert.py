@@ -1,4 +1,4 @@
-"""Spec text is inert in the package READMEs (Python, Rust, Arduino): a title and a description full of HTML
+"""Spec text is inert in the package READMEs (Python, Rust, Arduino, npm): a title and a description full of HTML
 and Markdown render, as CommonMark (PyPI's, crates.io's and GitHub's reading), to exactly that text, and add no
 element to the page: the same tags, as many of each, as the README of the plain spec."""
 
@@ -15,7 +15,7 @@ from markdown_it import MarkdownIt
 TITLE = "<img src=x onerror=alert(1)> **bold** _it_ [link](javascript:alert(1)) `code` ~~gone~~ | a | b | # not &amp;"
 DESCRIPTION = ("- not a list <script>alert(1)</script> <!-- hidden --> ![image](x.png) <https://example.invalid> "
                "*emphasis* 1. two [ref]: /url")
-READMES = ("python/README.md", "rust/README.md", "arduino/DroneProtocol/README.md")
+READMES = ("python/README.md", "rust/README.md", "arduino/DroneProtocol/README.md", "typescript/README.md")
 
 
 def generated(tmp_path: Path, *edits: tuple[str, str]) -> Path:

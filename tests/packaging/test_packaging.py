@@ -8,11 +8,13 @@ import re
 import shutil
 import subprocess
 import sys
+import tomllib
 import venv
 import zipfile
 from pathlib import Path
 
 import drone_protocol as dp
+import make_dist
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -20,8 +22,9 @@ CODEC = ROOT / "generated" / "python"
 BIN = Path(sys.executable).parent
 
 
-def _run(*cmd: str | Path, cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess[str]:
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+def _run(*cmd: str | Path, cwd: Path, timeout: float = 300,
+         env_extra: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")} | (env_extra or {})
     return subprocess.run([str(c) for c in cmd], cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
 
 
@@ -60,6 +63,10 @@ def test_the_codec_wheel_holds_the_package_alone(codec_wheel: Path) -> None:
     assert re.search(r"^Requires-Python: >=3\.9$", meta, re.M)
     assert "Requires-Dist" not in meta
     assert dp.SPEC_FINGERPRINT in meta  # the README is the long description
+    assert re.search(r"^License-Expression: MIT$", meta, re.M) and "Project-URL" not in meta
+    with zipfile.ZipFile(codec_wheel) as zf:
+        licence = zf.read(f"{dp.PROTOCOL_NAME}-{dp.__version__}.dist-info/licenses/LICENSE")
+    assert licence == (ROOT / "LICENSE").read_bytes()
 
 
 def test_the_codec_wheel_installs_and_imports_in_a_fresh_venv_with_nothing_else(
@@ -88,21 +95,19 @@ def test_the_codec_wheel_installs_and_imports_in_a_fresh_venv_with_nothing_else(
 
 
 def test_the_project_wheel_installs_one_namespace_of_its_own(tmp_path: Path) -> None:
-    src = tmp_path / "project"
-    src.mkdir()
-    for name in ("pyproject.toml", "setup.py", "README.md", "LICENSE", "generator", "pilot"):
-        path = ROOT / name
-        if path.is_dir():
-            shutil.copytree(path, src / name, ignore=shutil.ignore_patterns("__pycache__"))
-        else:
-            shutil.copy(path, src / name)
-    wheel = _wheel(src, tmp_path)
+    wheel = _wheel(make_dist.copy_tools_source(tmp_path / "project"), tmp_path)
     with zipfile.ZipFile(wheel) as zf:
         names = zf.namelist()
     tops = {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")}
     assert tops == {"drone_protocol_tools"}
     assert "drone_protocol_tools/generator/cli.py" in names and "drone_protocol_tools/pilot/app/cli.py" in names
     assert any(n.startswith("drone_protocol_tools/generator/templates/python/") for n in names)
+    # package data: the simulator's parameters and the virtual drone's sources (nothing read from the repository)
+    assert {"drone_protocol_tools/pilot/sim/arducopter.yaml", "drone_protocol_tools/pilot/sim/drone.parm",
+            "drone_protocol_tools/pilot/sim/firmware/host/virtual_drone.cpp"} <= set(names)
+    meta = _metadata(wheel)
+    assert re.search(r"^Requires-Python: >=3\.9$", meta, re.M)
+    assert "Project-URL" not in meta and "Home-page" not in meta  # no placeholder: there is no public URL
     assert re.search(rf"^Requires-Dist: {dp.PROTOCOL_NAME.replace('_', '-')}$", _metadata(wheel), re.M)
 
 
@@ -121,9 +126,28 @@ def test_the_console_scripts_outside_the_repo(tmp_path: Path) -> None:
     gen = _run(BIN / "drone-protocol-gen", cwd=tmp_path)
     assert gen.returncode == 2 and not (tmp_path / "generated").exists()
     assert gen.stderr.count("\n") == 1 and "pass --spec FILE" in gen.stderr, gen.stderr
+    helped = _run(BIN / "drone-protocol-gen", "--help", cwd=tmp_path)
+    assert helped.returncode == 0 and "python -m generator" not in helped.stdout, helped.stdout
+    assert helped.stdout.startswith("usage: drone-protocol-gen [-h]")
+    assert "  drone-protocol-gen diff OLD [NEW]" in helped.stdout
+    diff_help = _run(BIN / "drone-protocol-gen", "diff", "--help", cwd=tmp_path)
+    assert diff_help.stdout.startswith("usage: drone-protocol-gen diff"), diff_help.stdout
     version = _run(BIN / "drone-protocol-gen", "--version", cwd=tmp_path)
     assert version.returncode == 0 and "no spec" in version.stdout
     with_spec = _run(BIN / "drone-protocol-gen", "--version", "--spec", ROOT / "spec" / "drone.yaml", cwd=tmp_path)
     assert with_spec.returncode == 0 and dp.SPEC_FINGERPRINT in with_spec.stdout
     pilot = _run(BIN / "pilot", "--version", cwd=tmp_path)
     assert pilot.returncode == 0 and dp.SPEC_FINGERPRINT in pilot.stdout, pilot.stdout + pilot.stderr
+
+
+def test_the_crate_package_holds_its_readme_and_license_with_complete_metadata(tmp_path: Path) -> None:
+    crate = ROOT / "generated" / "rust"
+    listed = _run("cargo", "package", "--list", "--locked", "--offline", "--allow-dirty", cwd=crate,
+                  env_extra={"CARGO_TARGET_DIR": str(tmp_path)})
+    assert listed.returncode == 0, listed.stderr
+    assert {"Cargo.toml", "README.md", "LICENSE"} <= set(listed.stdout.split())
+    # cargo's "manifest has no documentation, homepage or repository" warning is gone
+    assert "warning: manifest has no" not in listed.stderr, listed.stderr
+    package = tomllib.loads((crate / "Cargo.toml").read_text(encoding="utf-8"))["package"]
+    assert package["documentation"] == f"https://docs.rs/{package['name']}"
+    assert "homepage" not in package and "repository" not in package  # none public: no placeholder

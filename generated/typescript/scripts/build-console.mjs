@@ -44,3 +44,6 @@ const script = [...parts, strip("console.html", main[2] ?? "")].join("\n").repla
 const bundled = page.slice(0, main.index) + (main[1] ?? "") + script + (main[3] ?? "") + page.slice(main.index + main[0].length);
 writeFileSync(join(root, "dist", "console.html"), bundled);
 console.log(`dist/console.html: ${bundled.length} bytes, ${MODULES.length} modules inlined`);
+// The CommonJS build (tsconfig.cjs.json) is in dist/cjs: a package.json of its own makes Node read its .js files
+// (and TypeScript its .d.ts files) as CommonJS inside this "type": "module" package.
+writeFileSync(join(root, "dist", "cjs", "package.json"), '{ "type": "commonjs" }\n');

@@ -116,7 +116,7 @@ def _best(flat: npt.NDArray[np.int32], ok: npt.NDArray[np.bool_], radii: npt.NDA
     py, px = np.nonzero(peaks)
     order = np.argsort(-plane[py, px])[:PER_BAND]
     return [(float(plane[y, x]), (x + 0.5) * CELL, (y + 0.5) * CELL, float(radii[best[y * grid.w + x]]))
-            for x, y in zip(px[order], py[order], strict=True)]
+            for x, y in zip(px[order], py[order])]
 
 
 def _strongest(dx: MatLike, dy: MatLike, ys: npt.NDArray[np.intp],

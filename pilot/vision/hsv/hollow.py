@@ -64,12 +64,12 @@ def hollow(image: MatLike, colour: ColourMask, bounds: Bounds, cx: float, cy: fl
     # calls on them, 3-10 µs each in a frame)
     bar = (sum(grey[_RING:]) / _MIDDLE + MARGIN) * len(RADII)
     near, mid, far = grey[:SECTORS], grey[SECTORS:2 * SECTORS], grey[2 * SECTORS:_RING]
-    brighter = [a + b + c > bar for a, b, c in zip(near, mid, far, strict=True)]
+    brighter = [a + b + c > bar for a, b, c in zip(near, mid, far)]
     if sum(brighter) < HOLLOW_SECTORS:
         return False
     hsv = cv2.cvtColor(pixels[:_RING].reshape(1, _RING, 3), colour.code)
     in_colour = (np.asarray(colour.in_range(hsv, bounds)).reshape(len(RADII), SECTORS) > 0).sum(axis=0).tolist()
-    lit = [b and n >= IN_COLOUR for b, n in zip(brighter, in_colour, strict=True)]
+    lit = [b and n >= IN_COLOUR for b, n in zip(brighter, in_colour)]
     return sum(lit) >= HOLLOW_SECTORS and SECTORS - _longest_gap(lit) >= HOLLOW_SPREAD
 
 

@@ -4,14 +4,14 @@ real edge of a piece an opening left, and the support of a robustly fitted ellip
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Union
 
 import cv2
 import numpy as np
 import numpy.typing as npt
 from cv2.typing import MatLike
 
-Points = npt.NDArray[np.integer[Any] | np.floating[Any]]  # a contour's points, N x 2
+Points = npt.NDArray[Union[np.integer[Any], np.floating[Any]]]  # a contour's points, N x 2
 Flags = npt.NDArray[np.bool_]
 
 ELLIPSE_TOL = 0.06  # a point within this share of the mean radius (at least 1 px) lies on the fitted ellipse
