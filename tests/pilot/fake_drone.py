@@ -100,6 +100,8 @@ class FakeDrone:
     # -- the firmware's policy ----------------------------------------------------------------------
     def _handle(self, name: dp.CommandName) -> dp.ErrorKind | None:
         state, armed = self.state, self.state in dp.ARMED_STATES
+        if name is C.QUERY_STATUS:
+            return None  # changes nothing, refused never: the reply's status is the answer
         if name in (C.LASER_ON, C.LASER_OFF):
             self.laser = name is C.LASER_ON
             self.log.append((self._now(), self.state, self.laser))
