@@ -82,6 +82,8 @@ class FakeDrone:
             self._reply(lambda state, laser: dp.rejected_line(kind, state, laser))
             return True
         self._last_valid = self._now()
+        if self.state is S.FAILSAFE and dp.CommandName(command.name) is not C.QUERY_STATUS:
+            self._set(S.DISARMED)  # as the firmware: the failsafe disarmed it; the query only reports it
         error = self._handle(dp.CommandName(command.name))
         if error is not None:
             self._reply(lambda state, laser: dp.rejected_line(error, state, laser))
