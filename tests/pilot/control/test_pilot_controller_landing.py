@@ -126,7 +126,8 @@ def test_failsafe_reply_lands_and_the_drone_confirms_laser_off() -> None:
     assert st(c) is State.LAND and "failsafe" in c.transitions[-1].reason
     assert c.laser_on is False and c.drone.state is dp.DroneState.FAILSAFE
     land_to_done(rig)
-    assert c.drone.safe and "failsafe" in c.transitions[-1].reason
+    # as the firmware does, the next frame after the failsafe (laser off) leaves it for disarmed
+    assert c.drone.safe and c.drone.state is dp.DroneState.DISARMED and "confirmed" in c.transitions[-1].reason
 
 
 def test_not_armed_reply_lands() -> None:
