@@ -6,7 +6,8 @@
 //   is the way down and ends in the disarm sequence;
 // - the self-test runs only disarmed (armed);
 // - the laser's on/off commands set it whatever its state; disarm and the
-//   failsafe switch it off (drone_logic.cpp).
+//   failsafe switch it off (drone_logic.cpp);
+// - the status query changes nothing, not even a failsafe (drone_logic.cpp).
 #include "drone_limits.h"
 #include "drone_logic.h"
 
@@ -140,5 +141,8 @@ void Drone::on_land(const dp::Command&) {
     enter(State::Landing);
   }
 }
+
+// Accepted whatever the state: the reply's status suffix is the answer.
+void Drone::on_query_status(const dp::Command&) {}
 
 }  // namespace drone

@@ -57,6 +57,18 @@ static_assert(sizeof(kSelfTest) / sizeof(kSelfTest[0]) < 256, "steps are counted
 static_assert(static_cast<uint32_t>(SELF_TEST_STEPS) * SELF_TEST_STEP_MS <= 0xFFFFu,
               "the state machine measures its spans in 16 bits");
 
+// Whether a command is the spec's status query (a spec without one has none):
+// dispatch() calls on_query_status only for it, and builds for any spec.
+struct QueryProbe {
+  bool query;
+  void on_query_status(const dp::Command&) { query = true; }
+};
+bool is_status_query(const dp::Command& c) {
+  QueryProbe probe = {false};
+  dp::dispatch(c, probe);
+  return probe.query;
+}
+
 }  // namespace
 
 bool operator==(const Outputs& a, const Outputs& b) {
@@ -110,8 +122,9 @@ bool Drone::receive(uint8_t byte, uint32_t now_ms) {
 void Drone::execute(const dp::Command& c, uint32_t now_ms) {
   // Any well-formed frame proves the link is alive, even one refused below.
   last_frame_ms_ = static_cast<uint16_t>(now_ms);
-  // The failsafe disarmed the drone: a new arming sequence is needed.
-  if (state_ == State::Failsafe) enter(State::Disarmed);
+  // The failsafe disarmed the drone: a new arming sequence is needed. The
+  // status query reports the failsafe instead of ending it.
+  if (state_ == State::Failsafe && !is_status_query(c)) enter(State::Disarmed);
   result_ = dp::Error::None;
   // A command this firmware has no handler for yet is answered `unsupported`.
   const dp::Error unhandled = dp::dispatch(c, *this);

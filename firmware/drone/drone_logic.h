@@ -94,6 +94,7 @@ class Drone {
   void on_hold_altitude(const dp::Command& c);
   void on_first_test(const dp::Command& c);
   void on_land(const dp::Command& c);
+  void on_query_status(const dp::Command& c);
 
  private:
   DRONE_NOINLINE void execute(const dp::Command& c, uint32_t now_ms);

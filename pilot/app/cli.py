@@ -6,6 +6,8 @@
     pilot --video flight.mp4 --dry-run       # decide and print the commands, send nothing
     pilot --calibrate sample.png --config pilot.yaml   # HSV ranges from a sample image into the config
     pilot --calibrate ball*.png --room empty*.png --config pilot.yaml   # learn the room's colour model
+    pilot check --port /dev/ttyACM0          # guided bring-up of the bench, propellers off
+    pilot report out/                        # one HTML page from a --record folder
 """
 
 from __future__ import annotations
@@ -51,7 +53,9 @@ MAX_SIZE = (4096, 4096)  # the simulated camera's largest frame (about 50 MB of 
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="pilot", description="The Raspberry Pi vision pilot of the drone.")
+    p = argparse.ArgumentParser(prog="pilot", description="The Raspberry Pi vision pilot of the drone.",
+                                epilog="pilot check --port PORT: guided bring-up of the bench (propellers off). "
+                                "pilot report DIR: one HTML page from a --record folder.")
     p.add_argument("--version", action="version", version=f"pilot {__version__} (protocol {dp.PROTOCOL_NAME} "
                    f"{dp.PROTOCOL_VERSION}, spec fingerprint {dp.SPEC_FINGERPRINT})")
     where = p.add_argument_group("where to fly")
@@ -342,7 +346,16 @@ def _fly_real(args: argparse.Namespace, cfg: PilotConfig) -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    words = list(sys.argv[1:] if argv is None else argv)
+    if words[:1] == ["check"]:  # pilot check --port PORT: the guided bring-up of the bench
+        from .check import main as check_main
+
+        return check_main(words[1:])
+    if words[:1] == ["report"]:  # pilot report DIR: one HTML page from a --record folder
+        from .report import main as report_main
+
+        return report_main(words[1:])
+    args = build_parser().parse_args(words)
     previous = signal.signal(signal.SIGTERM, _on_sigterm)
     try:
         if args.calibrate:

@@ -12,14 +12,21 @@ from .runner import Tick
 FONT = cv2.FONT_HERSHEY_SIMPLEX
 OUTLINE = (0, 0, 0)
 TEXT = (255, 255, 255)
+OUTLINE_SHIFTS = tuple((dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1) if dx or dy)
 
 
 def outlined_text(
     img: MatLike, text: str, org: tuple[int, int], scale: float, colour: tuple[int, int, int] = TEXT
 ) -> None:
-    """Text with a dark outline under it: light letters on a dark rim read on any background."""
+    """Text with a dark outline under it: light letters on a dark rim read on any background.
+
+    The rim is the same text at the same thickness, shifted a pixel each way: a thicker stroke would also space
+    the letters wider (Hershey advances grow with the thickness), so its last letters would stick out beside the
+    light ones ("land" read "landd")."""
     thickness = max(1, round(scale * 1.5))
-    cv2.putText(img, text, org, FONT, scale, OUTLINE, thickness + 2, cv2.LINE_AA)
+    x, y = org
+    for dx, dy in OUTLINE_SHIFTS:
+        cv2.putText(img, text, (x + dx, y + dy), FONT, scale, OUTLINE, thickness, cv2.LINE_AA)
     cv2.putText(img, text, org, FONT, scale, colour, thickness, cv2.LINE_AA)
 
 

@@ -289,6 +289,8 @@ class ControllerCore:
                 why = f"drone confirmed armed ({state.name.lower()})" if state else "armed (unconfirmed)"
                 self._go(State.TAKEOFF, why)
                 return self._on_takeoff(det)
+            if state is dp.DroneState.ARMED:
+                return self._emit(dp.hold_altitude())  # AltHold, sticks neutral, before the climb
             return self._status_poll()
         if self._elapsed() >= 2 * dp.ARMING_HOLD_MS + dp.FAILSAFE_TIMEOUT_MS + self.cfg.arm_margin_ms:
             self._go(State.LAND, f"drone never confirmed armed ({self.drone.describe()})")
@@ -298,12 +300,12 @@ class ControllerCore:
         return self._status_poll()
 
     def _status_poll(self) -> bytes | None:
-        """Waiting for the drone to confirm a change: a harmless frame every tick, since only a reply tells
-        (refused as busy during a sequence); nothing when no drone answers (a dry run)."""
+        """Waiting for the drone to confirm a change: the status query every tick, since only a reply tells (it
+        changes nothing and is never refused); nothing when no drone answers (a dry run)."""
         if self.drone.state is None:
             return None
         self.polling = True
-        return self._emit(dp.hold_altitude())
+        return self._emit(dp.query_status())
 
     def _on_takeoff(self, det: Detection | None) -> bytes | None:
         if self._elapsed() >= self.cfg.takeoff_ms:

@@ -326,6 +326,7 @@ def simulate(
     until_ms: float,
     elf: Path = UNO_ELF,
     mcu: str = "atmega328p",
+    timeout_s: float = 120.0,
 ) -> SimResult:
     """Run the real firmware in simavr; `events` are (time in ms, bytes injected then)."""
     script = "".join(f"{t:.3f} {data.hex()}\n" for t, data in events)
@@ -334,7 +335,7 @@ def simulate(
         input=script,
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=timeout_s,
         check=False,
     )
     assert result.returncode == 0, result.stderr

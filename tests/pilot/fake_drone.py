@@ -82,6 +82,8 @@ class FakeDrone:
             self._reply(lambda state, laser: dp.rejected_line(kind, state, laser))
             return True
         self._last_valid = self._now()
+        if self.state is S.FAILSAFE and dp.CommandName(command.name) is not C.QUERY_STATUS:
+            self._set(S.DISARMED)  # as the firmware: the failsafe disarmed it; the query only reports it
         error = self._handle(dp.CommandName(command.name))
         if error is not None:
             self._reply(lambda state, laser: dp.rejected_line(error, state, laser))
@@ -100,6 +102,8 @@ class FakeDrone:
     # -- the firmware's policy ----------------------------------------------------------------------
     def _handle(self, name: dp.CommandName) -> dp.ErrorKind | None:
         state, armed = self.state, self.state in dp.ARMED_STATES
+        if name is C.QUERY_STATUS:
+            return None  # changes nothing, refused never: the reply's status is the answer
         if name in (C.LASER_ON, C.LASER_OFF):
             self.laser = name is C.LASER_ON
             self.log.append((self._now(), self.state, self.laser))

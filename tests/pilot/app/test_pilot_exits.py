@@ -68,7 +68,7 @@ def test_second_interrupt_runs_the_shortest_safe_sequence_until_the_drone_confir
     assert isinstance(result.error, KeyboardInterrupt)
     assert any("interrupted again" in e for e in result.shutdown_errors)
     after = wire.sent[wire.sent.index("<second Ctrl-C>") + 1 :]
-    assert set(after) <= {"land", "hold_altitude", "laser_off"}  # nothing else: the shortest sequence
+    assert set(after) <= {"land", "hold_altitude", "query_status", "laser_off"}  # nothing else: the shortest sequence
     # it went on until the drone confirmed it (the landing routine, then the disarm sequence)
     assert wire.drone.state is dp.DroneState.DISARMED and not wire.drone.laser
     assert result.safe and result.confirmed.startswith("disarmed") and result.state is State.DONE
@@ -155,7 +155,7 @@ def test_cli_signal_with_laser_on_lands_and_prints_what_the_drone_confirmed(tmp_
     assert sent[0] == "arm" and "laser_toggle" not in sent and "move_down" not in sent
     after = sent[len(sent) - sent[::-1].index("laser_on") :]
     assert after[0] == "laser_off" and "land" in after
-    assert set(after) <= {"laser_off", "servo_reset", "land", "hold_altitude"}
+    assert set(after) <= {"laser_off", "servo_reset", "land", "hold_altitude", "query_status"}
     assert drone.drone.state is dp.DroneState.DISARMED and not drone.drone.laser
     assert "the drone confirmed: disarmed (not armed), laser off" in out.decode()
 

@@ -147,7 +147,8 @@ def assert_safe_tail(sent: list[str]) -> None:
     tail = sent[len(sent) - sent[::-1].index("laser_on") :]
     off = tail.index("laser_off")
     assert "land" not in tail[:off], tail
-    assert "land" in tail and set(tail[off:]) <= {"laser_off", "servo_reset", "land", "hold_altitude"}, tail
+    allowed = {"laser_off", "servo_reset", "land", "hold_altitude", "query_status"}
+    assert "land" in tail and set(tail[off:]) <= allowed, tail
 
 
 @pytest.mark.parametrize("stage", STAGES)

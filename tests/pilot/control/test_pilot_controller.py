@@ -27,7 +27,8 @@ def test_arm_waits_for_the_drone_to_confirm_it_then_takes_off() -> None:
         out = rig.tick(MISS)
         ticks += 1
         if st(c) is State.ARM:
-            assert name(out) == "hold_altitude", "the arm frame arrived: status polls until the drone confirms"
+            # the arm frame arrived: status queries until the drone confirms, AltHold once it is armed
+            assert name(out) == ("hold_altitude" if c.drone.state is dp.DroneState.ARMED else "query_status")
             assert c.drone.state is dp.DroneState.ARMING or c.drone.state in dp.ARMED_STATES
     assert st(c) is State.TAKEOFF and name(out) == "move_up"
     assert out is not None and dp.decode(out).value > dp.CHANNELS[dp.ChannelName.THROTTLE].median

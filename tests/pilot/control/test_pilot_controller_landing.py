@@ -34,7 +34,7 @@ def test_fire_lights_by_confirmation_then_lands_through_the_firmware_routine() -
     assert abs(c.lit_ms - CFG.fire_ms) <= 50
     frames = land_to_done(rig)
     assert frames[:2] == ["servo_reset", "land"]  # the firmware's landing routine, then only status polls
-    assert "disarm" not in frames and set(frames[2:]) <= {"land", "hold_altitude"}
+    assert "disarm" not in frames and set(frames[2:]) <= {"land", "query_status"}
     assert rig.drone.state is dp.DroneState.DISARMED and not rig.drone.laser
     assert c.drone.safe and "confirmed disarmed" in c.transitions[-1].reason
     assert "laser_toggle" not in [name(f) for f in rig.sent]
@@ -126,7 +126,13 @@ def test_failsafe_reply_lands_and_the_drone_confirms_laser_off() -> None:
     assert st(c) is State.LAND and "failsafe" in c.transitions[-1].reason
     assert c.laser_on is False and c.drone.state is dp.DroneState.FAILSAFE
     land_to_done(rig)
-    assert c.drone.safe and "failsafe" in c.transitions[-1].reason
+    # as the firmware does, the next frame after the failsafe (laser off) leaves it for disarmed
+    assert c.drone.safe and drone_state(c) is dp.DroneState.DISARMED and "confirmed" in c.transitions[-1].reason
+
+
+def drone_state(c: Controller) -> dp.DroneState | None:
+    """The confirmed state, read through a call (an attribute read keeps the type an earlier assert narrowed)."""
+    return c.drone.state
 
 
 def test_not_armed_reply_lands() -> None:
@@ -146,7 +152,7 @@ def test_abort_while_firing_lands_and_waits_for_the_drone() -> None:
     c.abort("test")
     assert st(c) is State.LAND and not c.want_laser
     frames = land_to_done(rig)
-    ordered = [f for f in frames if f not in ("servo_reset", "hold_altitude")]  # servos home only if moved
+    ordered = [f for f in frames if f not in ("servo_reset", "query_status")]  # servos home only if moved
     assert ordered == ["laser_off", "land"]
     assert rig.drone.state is dp.DroneState.DISARMED and c.drone.safe
     # the firmware's landing routine and disarm sequence ran, and nothing after the drone confirmed
@@ -160,7 +166,7 @@ def test_abort_on_the_ground_disarms_plainly() -> None:
     c.abort("test")
     assert name(c.update(None)) == "disarm"
     c.on_reply(refusal(dp.ErrorKind.BUSY, dp.DroneState.DISARMING))
-    assert name(c.update(None)) == "hold_altitude"  # status polls while it disarms
+    assert name(c.update(None)) == "query_status"  # status polls while it disarms
     c.on_reply(refusal(dp.ErrorKind.NOT_ARMED, dp.DroneState.DISARMED))
     assert c.update(None) is None and st(c) is State.DONE and c.drone.safe
 
@@ -233,7 +239,7 @@ def test_a_board_that_reports_disarmed_without_disarming_still_gets_the_disarm_s
     c.on_reply(refusal(dp.ErrorKind.NOT_ARMED, dp.DroneState.DISARMED))  # straight from moving to disarmed
     assert st(c) is State.LAND
     waited = 0
-    while name(out := c.update(None)) in ("servo_reset", "hold_altitude"):
+    while name(out := c.update(None)) in ("servo_reset", "query_status"):
         rig.clock.advance_ms(50)
         waited += 50
         assert waited <= dp.LANDING_MS + 100

@@ -70,15 +70,18 @@ def fly(keep_every: int = 1, seconds: float = 12.0) -> tuple[Wire, Seen, FakeDro
 def test_a_status_poll_goes_out_poll_copies_times_and_every_other_frame_once() -> None:
     wire, seen, _ = fly()
     per_tick = Counter(wire.sent)
-    polls = {n for (t, name), n in per_tick.items() if name == "hold_altitude" and seen.state.get(t) is State.ARM}
+    polls = {n for (t, name), n in per_tick.items() if name == "query_status" and seen.state.get(t) is State.ARM}
     # the time limit ends the run searching: the landing after it is the runner's (no tick observed)
-    landing = {n for (t, name), n in per_tick.items() if name == "hold_altitude" and t not in seen.state}
+    landing = {n for (t, name), n in per_tick.items() if name == "query_status" and t not in seen.state}
     flying = {n for (t, name), n in per_tick.items()
-              if name == "hold_altitude" and seen.state.get(t) not in (State.ARM, State.LAND, None)}
-    others = {n for (t, name), n in per_tick.items() if name != "hold_altitude"}
+              if name == "hold_altitude" and seen.state.get(t) not in (State.LAND, None)}
+    others = {n for (t, name), n in per_tick.items() if name not in ("hold_altitude", "query_status")}
     assert POLL_COPIES > 1 and polls == {POLL_COPIES}  # waiting for the drone to confirm it armed
     assert landing == {POLL_COPIES}  # and, once landing, that it disarmed
-    assert flying == {1} and others == {1}  # the hold (and any keep-alive) in flight, and every other frame: once
+    # AltHold once armed, the hold (and any keep-alive) in flight, and every other frame: once
+    assert flying == {1} and others == {1}
+    assert not {name for (t, name) in per_tick if name == "query_status" and seen.state.get(t) not in (State.ARM,
+                                                                                                          None)}
     assert {State.ARM, State.HOLD, State.SEARCH} <= set(seen.state.values())  # it flew through both
 
 
