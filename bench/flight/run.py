@@ -45,16 +45,17 @@ def jobs(seeds: int, gust_seeds: int, executable: str | None, gusts: float = GUS
     return out
 
 
-def held_out_jobs(seeds: int, gust_seeds: int, executable: str | None, detectors: tuple[str, ...]) -> list[FlightJob]:
+def held_out_jobs(seeds: int, gust_seeds: int, executable: str | None, detectors: tuple[str, ...],
+                  first: int = 0) -> list[FlightJob]:
     """Seeds no tuning run flew (bench/flight/strict.py), seed by seed so that a campaign cut short is balanced."""
     out: list[FlightJob] = []
-    for k in range(max(seeds, gust_seeds)):
+    for k in range(first, first + max(seeds, gust_seeds)):
         for name in SCENARIOS:
-            if k < seeds:
+            if k < first + seeds:
                 out += [FlightJob(name, HELD_OUT_STILL + k, "hsv", executable=executable)] if "hsv" in detectors else []
                 out += [FlightJob(name, HELD_OUT_STILL + k, "aruco", width=640, height=480, executable=executable)
                         ] if "aruco" in detectors else []
-            if k < gust_seeds:
+            if k < first + gust_seeds:
                 out.append(FlightJob(name, HELD_OUT_GUSTS + k, "hsv", executable=executable, gusts=GUSTS))
     return out
 
@@ -74,7 +75,8 @@ def held_out(args: argparse.Namespace) -> int:
     """The strict campaign on held-out seeds (RESULTS-held-out.md), or its HSV flights with another speed step
     (RESULTS-step<N>.md, compared flight by flight with the held-out log)."""
     detectors = ("hsv",) if args.step_us else (args.detector,) if args.detector else ("hsv", "aruco")
-    name = f"step{args.step_us}" if args.step_us else "held-out"
+    name = (f"step{args.step_us}" if args.step_us else "held-out") + (f"-from{args.first_seed}" if args.first_seed
+                                                                       else "")
     log = LOG.with_name(f"{name}.jsonl")
     t0 = time.perf_counter()
     executable = args.virtual_drone
@@ -82,7 +84,8 @@ def held_out(args: argparse.Namespace) -> int:
         with tempfile.TemporaryDirectory(prefix="bench-flight-step") as tmp:
             if args.step_us:
                 executable = str(respec(args.step_us, Path(tmp)))
-            todo = held_out_jobs(args.seeds, 0 if args.step_us else args.gust_seeds, executable, detectors)
+            todo = held_out_jobs(args.seeds, 0 if args.step_us else args.gust_seeds, executable, detectors,
+                                 args.first_seed)
             campaign(todo, args.processes, log)
     rows = [json.loads(line) for line in log.read_text().splitlines() if line.strip()]
     base = LOG.with_name("held-out.jsonl")

@@ -42,6 +42,8 @@ def respec(step_us: int, root: Path) -> Path:
     build = root / "fw"
     subprocess.run(["make", "-s", "firmware-host", f"FW_BUILD={build}",
                     f"DRONE_PROTOCOL_DIR={generated / 'arduino' / 'DroneProtocol'}"], cwd=REPO, check=True)
+    # spawned processes start from this one's sys.path (multiprocessing passes it on), and from PYTHONPATH
+    sys.path.insert(0, str(generated / "python"))
     os.environ["PYTHONPATH"] = os.pathsep.join([str(generated / "python"), str(REPO)])
     return build / "host" / "virtual_drone"
 

@@ -178,6 +178,8 @@ def test_the_campaign_tables_count_strict_successes_reasons_and_step_ratios() ->
     assert {j.seed for j in jobs if not j.gusts} == {HELD_OUT_STILL, HELD_OUT_STILL + 1}
     assert {j.seed for j in jobs if j.gusts} == {HELD_OUT_GUSTS} and len(jobs) == 14 * 5
     assert [j.detector for j in jobs[:3]] == ["hsv", "aruco", "hsv"]  # seed by seed: a campaign cut short is balanced
+    more = held_out_jobs(1, 0, None, ("aruco",), first=2)  # a later run goes on from the third seed
+    assert {(j.seed, j.detector, j.gusts) for j in more} == {(HELD_OUT_STILL + 2, "aruco", 0.0)} and len(more) == 14
     late = "spot on the target 40 ms at most without a break (fire time 1500 ms)"
     base = [_row("ahead", 1, "hsv", True, 10.0), _row("side", 1, "hsv", True, 14.0),
             _row("dim", 1, "hsv", False, None, 60.0, (late, "the fire did not complete"))]
