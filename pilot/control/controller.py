@@ -1,53 +1,13 @@
 """The pilot's decision logic: one explicit state machine over detections, with an injected clock.
 
-``Controller.update(detection)`` is called once per frame and returns the frame to send now (or
-``None``: nothing new, the link keeps the firmware alive). Every frame is built by a
-``drone_protocol`` function; every time and pulse limit comes from its constants.
-
-States (``State``)::
+``Controller.update(detection)`` is called once per frame and returns the frame to send now (or ``None``: the link
+keeps the firmware alive). Every frame is built by a ``drone_protocol`` function; every pulse comes from the spec
+(``pulses.py``). The vision phases (SEARCH .. FIRE) are here, arming and landing in ``controller_core.py``::
 
     IDLE -> ARM -> TAKEOFF -> HOLD -> SEARCH <-> ACQUIRE -> TRACK <-> AIM -> FIRE -> LAND -> DONE
-                                        ^                    |        |      |
-                                        +---- target lost ---+--------+------+   (neutral first)
 
-* The drone's state and laser come from its replies (``DroneView``), never from what was sent. Whenever
-  the confirmed laser differs from what the pilot wants, the deterministic ``laser_on()``/``laser_off()``
-  goes out before anything else, so a lost frame costs one reply round trip.
-* ARM sends ``arm()`` (again whenever the drone reports it disarmed) until the drone confirms an armed
-  state, then waits ``arm_margin_ms``; it gives up if no arming is confirmed in time.
-* TAKEOFF climbs (``move_up``) for ``takeoff_ms``; HOLD sends ``hold_altitude()`` for ``settle_ms``.
-* SEARCH turns (a bounded sweep: ``search_max_ms`` in all, unconfirmed sightings included, then LAND)
-  towards the side the target was last seen, in legs of ``search_leg_ms`` (about a turn) flown at the start
-  height, one ``search_step_ms`` climb below it, one above it...: something in front may hide the target
-  from one height. A search after a sighting first goes back to the height it was seen from (``SeenFrom``).
-* ACQUIRE stops turning and needs ``acquire_frames`` consecutive sightings to go on to TRACK; after
-  ``lost_frames`` misses in a row it searches again.
-* TRACK corrects one axis per frame: yaw while the horizontal error is outside its dead band, then
-  height while the vertical error is, else forward until the apparent size reaches ``approach_size``.
-  The camera leans with the airframe (``Lean``, estimated from the pitch commands): a brake is never so hard
-  that its lean drops the target out of the frame. A target lost after a climb (or descent) is hidden from
-  above (below): a ceiling (floor) just inside the height it was seen from bars the height correction while the
-  target stays near the frame's middle, and the approach goes on off-centre (``pilot.control.vertical``).
-  AIM begins there and returns to TRACK only below ``retreat_size`` (hysteresis); above ``back_off_size`` it
-  backs off before it fires. Back in TRACK with the camera panned, the body turns to the target before the
-  servos reset (a reset would otherwise swing it out of the frame). A target that stands still in the frame through
-  ``response.NO_RESPONSE_MS`` of hard turning means a drone that does not answer its sticks (crashed, caught): LAND.
-  Up to ``coast_frames`` missed frames during a forward approach keep it going (a
-  far target flickers in and out of detection).
-* AIM holds position and centres the target with the pan/tilt servos (only from measured sightings: a
-  tracker's prediction knows nothing of the step just sent); after ``aim_frames`` centred
-  frames FIRE switches the laser on (not while the detector sees something else at the aim point: a thing in
-  front of the target hides its middle while the circle through its rim stays centred). The laser stays on only
-  while the target is found, centred, in range and clear at the aim point;
-  after ``fire_ms`` lit without a break (as the drone confirmed it) it is switched off and the drone lands. While
-  firing, small errors (within twice the aim tolerance) are still corrected
-  with the servos; larger ones switch the laser off and go back to AIM.
-* Losing the target (``lost_frames`` misses in a row) in ACQUIRE/TRACK/AIM/FIRE: laser off, sticks
-  neutral (``hold_altitude()``), servos reset, and SEARCH again.
-* LAND (also what ``abort()`` leads to): laser off until confirmed, servos home, then the firmware's
-  landing routine (``land()``; ``disarm()`` when the drone is armed on the ground) until the drone
-  confirms a landing, then keep-alives until it confirms not armed with the laser off (DONE). After
-  ``land_ms`` without that confirmation it stops (DONE) and the firmware's failsafe takes over.
+The drone's state and laser are only what its replies confirmed (``DroneView``). What each state does and why:
+pilot/README.md, "The controller".
 """
 
 from __future__ import annotations

@@ -23,7 +23,7 @@ def _read_every_name() -> None:
         dp.DroneState.LANDING, dp.ErrorKind.AIRBORNE, dp.ErrorKind.NOT_ARMED, dp.FAILSAFE_TIMEOUT_MS, dp.LANDING_MS,
         dp.PROTOCOL_NAME, dp.PROTOCOL_VERSION, dp.ProtocolError, dp.READY_TIMEOUT_MS, dp.Reply,
         dp.ReplyKind.FAILSAFE, dp.ReplyKind.READY, dp.ReplyKind.REJECTED, dp.SERVOS, dp.SPEC_FINGERPRINT,
-        dp.SPEED_STEP_US, dp.ServoName.PAN, dp.ServoName.TILT, dp.arm, dp.decode, dp.disarm, dp.hold_altitude,
+        dp.FLIGHT_CONTROLLER_PARAMETERS, dp.ServoName.PAN, dp.ServoName.TILT, dp.arm, dp.decode, dp.disarm, dp.hold_altitude,
         dp.land, dp.laser_off, dp.laser_on, dp.move_backward, dp.move_down, dp.move_forward, dp.move_up,
         dp.parse_reply, dp.query_status, dp.servo_down, dp.servo_left, dp.servo_reset, dp.servo_right, dp.servo_up,
         dp.turn_left, dp.turn_right, dp.COMMANDS.values, dp.CommandSpec, dp.FAILSAFE_THROTTLE_US,
