@@ -269,3 +269,14 @@ fn decode_never_panics_on_random_bytes() {
         }
     }
 }
+
+#[test]
+fn every_command_is_found_by_its_name_and_codes_with_its_default() {
+    for id in CommandId::ALL {
+        let info = id.info();
+        assert_eq!(CommandId::from_name(id.name()), Some(id));
+        assert_eq!(CommandId::from_codes(info.category.code(), info.direction), Some(id));
+        assert_eq!(id.default_value(), info.default);
+    }
+    assert_eq!(CommandId::from_name("no_such_command"), None);
+}
