@@ -259,3 +259,12 @@ def test_the_c_lookup_by_name_and_defaults_agree_with_the_spec(tmp_path: Path) -
     out = subprocess.run([str(exe)], capture_output=True, text=True, timeout=60, check=True).stdout.splitlines()
     expected = [f"{name} 1 {int(s.default is not None)} {s.default or 0}" for name, s in dp.COMMANDS.items()]
     assert out == [*expected, "-1 -1"]
+
+
+@pytest.mark.parametrize("name", ["find_command", "command_default", "missing_value", "command_min"])
+def test_a_command_cannot_take_the_name_of_an_api_entry(name: str, tmp_path: Path) -> None:
+    spec = tmp_path / "drone.yaml"
+    spec.write_text(h.edited_spec(("        name: first_test", f"        name: {name}")), encoding="utf-8")
+    run = h.generate("--spec", spec, "--out", tmp_path / "out")
+    assert run.code == 2 and "clashes with a name the generated code defines" in run.stderr, run.stderr
+    assert not (tmp_path / "out").exists()
