@@ -38,7 +38,8 @@ GENERATED_NAMES = frozenset(
     """encode decode dispatch command_info command_name channel_limits error_name error_code parse_reply
     ready_line accepted_line rejected_line failsafe_line write_ready write_accepted write_rejected
     write_failsafe stream_parser stream_decoder command category direction value name error reply time
-    dataclass annotations detail""".split()
+    dataclass annotations detail find_command find_command_by_name command_default missing_value command_min
+    command_max command_target command_sense state_code state_name state_armed""".split()
 ) | PYTHON_BUILTINS_USED
 
 MAX_NAME = 40  # a name becomes a file name, a C++ macro prefix and a Python identifier: keep it readable

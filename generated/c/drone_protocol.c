@@ -455,3 +455,17 @@ size_t dp_write_rejected(dp_error error, dp_status status, char out[DP_REPLY_MAX
 size_t dp_write_failsafe(dp_status status, char out[DP_REPLY_MAX_LENGTH]) {
   return end_line(out, put_status(out, put(out, 0, REPLY_PREFIXES[DP_REPLY_FAILSAFE]), status));
 }
+
+int dp_find_command_by_name(const char *name) {
+  for (int i = 0; name != NULL && i < DP_COMMAND_COUNT; ++i) {
+    if (strcmp(dp_command_name((dp_command_id)i), name) == 0) return i;
+  }
+  return -1;
+}
+
+bool dp_command_default(dp_command_id id, uint16_t *value) {
+  const dp_command_info *info = dp_command_info_of(id);
+  if (info == NULL || !info->has_default) return false;
+  *value = info->default_value;
+  return true;
+}

@@ -219,6 +219,11 @@ char dp_error_code(dp_error error);
 /* The error of a reply code letter, or DP_ERROR_NONE. */
 dp_error dp_error_from_code(char code);
 
+/* The command of this name in the spec (snake_case), or -1. */
+int dp_find_command_by_name(const char *name);
+/* The command's default value in *value and true, or false for a command without one (or an unknown id). */
+bool dp_command_default(dp_command_id id, uint16_t *value);
+
 /* Is this byte a category? */
 static inline bool dp_is_category(uint8_t byte) {
   switch (byte) {

@@ -91,7 +91,7 @@ def test_an_accepted_reply_prefix_gives_working_code(prefix: str, tmp_path: Path
 
 # Names the generated Python module uses itself (builtins it calls, its own functions): a command of that name
 # would be a module-level function that replaces them.
-SHADOWING = ["ord", "isinstance", "bytes", "len", "chr", "ready_line", "failsafe_line"]
+SHADOWING = ["ord", "isinstance", "bytes", "len", "chr", "ready_line", "failsafe_line", "find_command", "missing_value"]
 
 
 @pytest.mark.parametrize("name", SHADOWING)

@@ -130,7 +130,8 @@ for v in vectors["vectors"]:
         assert v["ok"] and c.name == v["command"] and c.value == v["value"], v
         assert c.encode() == frame
     except p.ProtocolError as e:
-        assert not v["ok"] and e.kind.value == {e["name"]: e["code"] for e in ERRORS}[v["error"]], (v, e)
+        assert not v["ok"] and e.kind.value == v["error"], (v, e)
+        assert e.kind.code == {e["name"]: e["code"] for e in ERRORS}[v["error"]], (v, e)
         assert e.position == v["position"], (v, e.position)
 valid = [bytes.fromhex(v["frame_hex"]) for v in vectors["vectors"] if v["ok"]]
 decoder = p.StreamDecoder()
@@ -155,7 +156,7 @@ def test_crc8_mode_round_trips_its_vectors_and_checks_replies(tmp_path: Path) ->
     spec = tmp_path / "drone.yaml"
     spec.write_text(h.edit(h.spec_text(), "  integrity: none\n", "  integrity: crc8\n"))
     assert h.generate("--spec", spec, "--out", tmp_path / "generated").code == 0
-    errors = [{"name": k.name.lower(), "code": k.value} for k in dp.ErrorKind]
+    errors = [{"name": k.name.lower(), "code": k.code} for k in dp.ErrorKind]
     script = tmp_path / "check.py"
     script.write_text(f"ERRORS = {errors!r}\n" + CRC8_CHECK)
     env = {**os.environ, "PYTHONPATH": str(tmp_path / "generated" / "python")}

@@ -13,7 +13,7 @@ Frames are 6 ASCII bytes: a category, a direction and 4 decimal digits.
 Python 3.9 or later, standard library only.
 """
 
-from .codec import Command, command_frame, decode, encode
+from .codec import Command, command_frame, decode, encode, find_command, find_command_by_name
 from .commands import (
     arm,
     disarm,
@@ -137,7 +137,7 @@ __all__ = [
     "TooLongError",
     "BadCheckError",
     "MissingValueError", "ReplyError", "ClockError",
-    "encode", "command_frame", "decode", "StreamDecoder",
+    "encode", "command_frame", "decode", "StreamDecoder", "find_command", "find_command_by_name",
     "move_forward",
     "move_backward",
     "move_left",

@@ -248,7 +248,7 @@ def encode(category: Category | str, direction: Direction | str | None = None,
         spec = _spec_of(category, direction)  # the slow path, which names what is wrong
     if value is None:
         if spec.default is None:
-            raise MissingValueError(f"{spec.name} needs a value in {spec.minimum}..{spec.maximum} {spec.unit}")
+            raise missing_value(spec)
         value = spec.default
     return frame_of(spec, value)
 
@@ -260,7 +260,7 @@ def command_frame(name: CommandName, value: int | None = None) -> bytes:
         raise TypeError(f"command_frame() takes a CommandName, not {name!r}")
     if value is None:
         if spec.default is None:
-            raise MissingValueError(f"{spec.name} needs a value in {spec.minimum}..{spec.maximum} {spec.unit}")
+            raise missing_value(spec)
         value = spec.default
     return frame_of(spec, value)
 
@@ -273,3 +273,18 @@ def frame_of(spec: CommandSpec, value: int) -> bytes:
         raise OutOfRangeError(f"{spec.name}: value {value} is outside {spec.minimum}..{spec.maximum} {spec.unit}", 2)
     return spec.prefix + b"%04d" % value
 
+
+def missing_value(spec: CommandSpec) -> MissingValueError:
+    """The error of a command without a default called without a value: the same from every entry point."""
+    return MissingValueError(f"{spec.name} needs a value in {spec.minimum}..{spec.maximum} {spec.unit}")
+
+
+def find_command(category: str, direction: str) -> CommandSpec | None:
+    """The command whose frame starts with these two characters (`'m'`, `'f'`), or None."""
+    table = BY_BYTES.get(ord(category)) if len(category) == 1 else None
+    return table.get(ord(direction)) if table is not None and len(direction) == 1 else None
+
+
+def find_command_by_name(name: str) -> CommandSpec | None:
+    """The command of this name in the spec (snake_case), or None."""
+    return COMMANDS.get(CommandName(name)) if name in CommandName._value2member_map_ else None

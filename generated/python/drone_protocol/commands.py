@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import Final
 
-from .codec import frame_of
+from .codec import frame_of, missing_value
 from .tables import COMMANDS, CommandName
 
 _MOVE_FORWARD: Final = COMMANDS[CommandName.MOVE_FORWARD]
@@ -67,23 +67,31 @@ def turn_right(speed: int | None = None) -> bytes:
     return frame_of(_TURN_RIGHT, 1624 if speed is None else speed)
 
 
-def servo_up(degrees: int) -> bytes:
-    """Up by `degrees` (1..180 deg)."""
+def servo_up(degrees: int | None = None) -> bytes:
+    """Up by `degrees` (1..180 deg; no default: MissingValueError without it)."""
+    if degrees is None:
+        raise missing_value(_SERVO_UP)
     return frame_of(_SERVO_UP, degrees)
 
 
-def servo_down(degrees: int) -> bytes:
-    """Down by `degrees` (1..180 deg)."""
+def servo_down(degrees: int | None = None) -> bytes:
+    """Down by `degrees` (1..180 deg; no default: MissingValueError without it)."""
+    if degrees is None:
+        raise missing_value(_SERVO_DOWN)
     return frame_of(_SERVO_DOWN, degrees)
 
 
-def servo_left(degrees: int) -> bytes:
-    """Left by `degrees` (1..180 deg)."""
+def servo_left(degrees: int | None = None) -> bytes:
+    """Left by `degrees` (1..180 deg; no default: MissingValueError without it)."""
+    if degrees is None:
+        raise missing_value(_SERVO_LEFT)
     return frame_of(_SERVO_LEFT, degrees)
 
 
-def servo_right(degrees: int) -> bytes:
-    """Right by `degrees` (1..180 deg)."""
+def servo_right(degrees: int | None = None) -> bytes:
+    """Right by `degrees` (1..180 deg; no default: MissingValueError without it)."""
+    if degrees is None:
+        raise missing_value(_SERVO_RIGHT)
     return frame_of(_SERVO_RIGHT, degrees)
 
 

@@ -98,8 +98,9 @@ def _parse(body: bytes) -> Reply:
             if len(rest) == 2 and ord(rest[0]) in BY_BYTES and ord(rest[1]) in BY_BYTES[ord(rest[0])]:
                 return Reply(kind, category=Category(rest[0]), direction=rest[1], state=state, laser=laser)
         elif kind is ReplyKind.REJECTED:
-            if rest in ErrorKind._value2member_map_:
-                return Reply(kind, error=ErrorKind(rest), state=state, laser=laser)
+            error = ErrorKind.from_code(rest)
+            if error is not None:
+                return Reply(kind, error=error, state=state, laser=laser)
         elif rest == "":
             return Reply(kind, state=state, laser=laser)
         raise ReplyError(f"malformed {kind.name.lower()} reply {text!r}")
@@ -136,7 +137,7 @@ def accepted_line(command: Command, state: DroneState, laser: bool) -> bytes:
 
 
 def rejected_line(error: ErrorKind, state: DroneState, laser: bool) -> bytes:
-    return _line(f"{ReplyKind.REJECTED.value}{error.value}{status_text(state, laser)}")
+    return _line(f"{ReplyKind.REJECTED.value}{error.code}{status_text(state, laser)}")
 
 
 def failsafe_line(state: DroneState, laser: bool) -> bytes:

@@ -60,6 +60,13 @@ class StreamDecoder:
     def reset(self) -> None:
         self._pending = b""
 
+    def feed_ms(self, data: BytesLike, now_ms: int) -> list[Command]:
+        """Feed bytes that arrived together at `now_ms` (integer milliseconds, as the other languages' parsers
+        take it); return the complete commands. `feed()` is the same in float seconds."""
+        if now_ms.__class__ is not int:
+            raise TypeError(f"now_ms must be an int number of milliseconds, not {type(now_ms).__name__}")
+        return self.feed(data, now_ms / 1000.0)
+
     def feed(self, data: BytesLike, now: float | None = None) -> list[Command]:
         """Feed bytes that arrived together at `now` (seconds, default time_fn()); return the complete commands."""
         if now is None:

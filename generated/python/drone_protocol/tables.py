@@ -257,34 +257,63 @@ class CommandName(_TextEnum):
 
 
 class ErrorKind(_TextEnum):
-    """Why a frame, a byte or a command was rejected; the value is the code of the Arduino's `E` reply."""
+    """Why a frame, a byte or a command was rejected; the value is the error's name in the spec, as in the other
+    languages (`bad_category`), and `code` is the letter of the Arduino's `E` reply."""
 
     #: The first byte is not a category
-    BAD_CATEGORY = "c"
+    BAD_CATEGORY = "bad_category"
     #: The second byte is not a direction of that category
-    BAD_DIRECTION = "d"
+    BAD_DIRECTION = "bad_direction"
     #: A value byte is not an ASCII digit
-    BAD_DIGIT = "g"
+    BAD_DIGIT = "bad_digit"
     #: The value is outside the command's allowed range
-    OUT_OF_RANGE = "r"
+    OUT_OF_RANGE = "out_of_range"
     #: A partial frame was dropped after an inter-byte gap
-    TIMEOUT = "t"
+    TIMEOUT = "timeout"
     #: The frame has fewer than 6 bytes
-    TOO_SHORT = "s"
+    TOO_SHORT = "too_short"
     #: The frame has more than 6 bytes
-    TOO_LONG = "l"
+    TOO_LONG = "too_long"
     #: A movement or turn was refused because the drone is disarmed
-    NOT_ARMED = "n"
+    NOT_ARMED = "not_armed"
     #: Refused while an arming, disarming, landing or self-test sequence runs
-    BUSY = "b"
+    BUSY = "busy"
     #: The command is in the spec but this firmware has no handler for it yet
-    UNSUPPORTED = "u"
+    UNSUPPORTED = "unsupported"
     #: Refused while the drone is armed (the self-test)
-    ARMED = "a"
+    ARMED = "armed"
     #: Refused while airborne (a disarm; land with il0000 instead)
-    AIRBORNE = "i"
+    AIRBORNE = "airborne"
     #: The frame's integrity check does not match its bytes (frame.integrity crc8)
-    BAD_CHECK = "x"
+    BAD_CHECK = "bad_check"
+
+    @property
+    def code(self) -> str:
+        """The letter of the Arduino's `E` reply for this error."""
+        return _ERROR_CODES[self]
+
+    @classmethod
+    def from_code(cls, code: str) -> ErrorKind | None:
+        """The error of an `E` reply's letter, or None."""
+        return _ERRORS_BY_CODE.get(code)
+
+
+_ERROR_CODES: Final[Mapping[ErrorKind, str]] = {
+    ErrorKind.BAD_CATEGORY: "c",
+    ErrorKind.BAD_DIRECTION: "d",
+    ErrorKind.BAD_DIGIT: "g",
+    ErrorKind.OUT_OF_RANGE: "r",
+    ErrorKind.TIMEOUT: "t",
+    ErrorKind.TOO_SHORT: "s",
+    ErrorKind.TOO_LONG: "l",
+    ErrorKind.NOT_ARMED: "n",
+    ErrorKind.BUSY: "b",
+    ErrorKind.UNSUPPORTED: "u",
+    ErrorKind.ARMED: "a",
+    ErrorKind.AIRBORNE: "i",
+    ErrorKind.BAD_CHECK: "x",
+}
+_ERRORS_BY_CODE: Final[Mapping[str, ErrorKind]] = {code: kind for kind, code in _ERROR_CODES.items()}
 
 
 class DroneState(_TextEnum):

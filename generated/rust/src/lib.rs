@@ -780,6 +780,18 @@ impl Command {
     }
 }
 
+impl CommandId {
+    /// The command of this name in the spec (snake_case).
+    pub fn from_name(name: &str) -> Option<CommandId> {
+        CommandId::ALL.iter().copied().find(|id| id.name() == name)
+    }
+
+    /// The value used when none is given, if the spec has one.
+    pub const fn default_value(self) -> Option<u16> {
+        self.info().default
+    }
+}
+
 /// Write the frame of `id` with `value` into `out`; refuses values outside the command's range.
 #[inline]
 pub fn encode(id: CommandId, value: u16, out: &mut Frame) -> Result<(), Error> {

@@ -309,3 +309,14 @@ fn ready_lines_follow_the_one_rule_of_the_spec() {
     }
     assert!(checked > 100, "too few ready lines in {path}");
 }
+
+#[test]
+fn every_command_is_found_by_its_name_and_codes_with_its_default() {
+    for id in CommandId::ALL {
+        let info = id.info();
+        assert_eq!(CommandId::from_name(id.name()), Some(id));
+        assert_eq!(CommandId::from_codes(info.category.code(), info.direction), Some(id));
+        assert_eq!(id.default_value(), info.default);
+    }
+    assert_eq!(CommandId::from_name("no_such_command"), None);
+}

@@ -4,7 +4,7 @@
 
 // One function per command of the spec: each returns the command's frame.
 
-import { entryOf, frameOf } from "./codec.js";
+import { encode, entryOf, frameOf } from "./codec.js";
 
 const MOVE_FORWARD = entryOf("m", "f");
 const MOVE_BACKWARD = entryOf("m", "b");
@@ -64,21 +64,29 @@ export function turnRight(speed: number = 1624): Uint8Array {
 
 /** Up by `degrees` (1..180 deg). */
 export function servoUp(degrees: number): Uint8Array {
+  // Called from JavaScript without a value: the same missing_value error as encode().
+  if ((degrees as number | undefined) === undefined) return encode("s", "u");
   return frameOf(SERVO_UP, degrees);
 }
 
 /** Down by `degrees` (1..180 deg). */
 export function servoDown(degrees: number): Uint8Array {
+  // Called from JavaScript without a value: the same missing_value error as encode().
+  if ((degrees as number | undefined) === undefined) return encode("s", "d");
   return frameOf(SERVO_DOWN, degrees);
 }
 
 /** Left by `degrees` (1..180 deg). */
 export function servoLeft(degrees: number): Uint8Array {
+  // Called from JavaScript without a value: the same missing_value error as encode().
+  if ((degrees as number | undefined) === undefined) return encode("s", "l");
   return frameOf(SERVO_LEFT, degrees);
 }
 
 /** Right by `degrees` (1..180 deg). */
 export function servoRight(degrees: number): Uint8Array {
+  // Called from JavaScript without a value: the same missing_value error as encode().
+  if ((degrees as number | undefined) === undefined) return encode("s", "r");
   return frameOf(SERVO_RIGHT, degrees);
 }
 

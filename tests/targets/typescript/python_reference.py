@@ -49,7 +49,7 @@ def info() -> None:
     print(json.dumps({
         "fingerprint": p.SPEC_FINGERPRINT,
         "sha256": p.SPEC_SHA256,
-        "errors": {kind.name.lower(): kind.value for kind in p.ErrorKind},
+        "errors": {kind.value: kind.code for kind in p.ErrorKind},
         "commands": {s.name: [s.category.value, s.direction.value, s.minimum, s.maximum, s.default]
                      for s in p.COMMANDS.values()},
         "accepted": [p.accepted_line(c, p.DroneState.MOVING, False).decode() for c in commands],

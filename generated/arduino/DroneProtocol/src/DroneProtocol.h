@@ -28,5 +28,6 @@
 #include "DroneProtocol_codec.h"
 #include "DroneProtocol_dispatch.h"
 #include "DroneProtocol_replies.h"
+#include "DroneProtocol_api.h"
 
 #endif  // DRONE_PROTOCOL_H

@@ -66,6 +66,7 @@ test("encode() refuses what the protocol does not allow", () => {
   assert.equal(code(() => dp.encode(spec.category + spec.category, spec.direction)), "bad_category");
   assert.equal(code(() => dp.encode(spec.category, "?")), "bad_direction");
   assert.equal(code(() => dp.encode(required.category, required.direction)), "missing_value");
+  assert.equal(code(() => dp[required.functionName]()), "missing_value");  // the same error from its own function
   const several = dp.CATEGORIES.find((c) => c.commands.length > 1);
   assert.equal(code(() => dp.encode(several.code)), "bad_direction");
   const single = dp.CATEGORIES.find((c) => c.commands.length === 1);
