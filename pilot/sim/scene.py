@@ -18,7 +18,7 @@ HIDDEN_GROUP = 4
 CAMERA_POS = (0.23, 0.0, -0.03)  # on the airframe's nose, below the arms
 ZNEAR = 0.001  # the camera's near clipping plane, in the room's extents (about 1 cm): at MuJoCo's 0.01 (11 cm), a
 # wall within 9 cm of the airframe's nose vanished, and the camera saw the black outside the room
-SHADOW_MAP_PX = 1024  # the shadow map's side: MuJoCo's 4096 costs the software renderer more for no visible gain
+SHADOW_MAP_PX = 256  # the shadow map's side: soft shadows, as under diffuse room light; 1024 cost 1.5x the render
 MOTOR_SPIN = (1, -1, 1, -1)  # front-left, front-right... alternating directions cancel the reaction torque
 
 
@@ -142,9 +142,11 @@ def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg
         bx, by = 0.022 * math.cos(f), 0.022 * math.sin(f)
         target_geoms.append(f'<geom name="target_backing" type="box" pos="{_f(bx, by, plate.centre[2])}" '
                             f'quat="{_yaw_quat(f)}" size="{_f(0.008, half, half)}" material="{pole}"/>')
-    shadows = "true" if sc.effects.shadows else "false"
+    # shadows from the brightest light only: each shadowing light costs the software renderer a pass
+    brightest = max(range(len(sc.lights)), key=lambda i: sum(sc.lights[i].rgb)) if sc.lights else -1
+    casts = ["true" if sc.effects.shadows and i == brightest else "false" for i in range(len(sc.lights))]
     lights = [f'<light name="light_{i}" pos="{_f(*lt.position)}" dir="{_f(*lt.direction)}" '
-              f'diffuse="{_f(*lt.rgb)}" specular="0.1 0.1 0.1" castshadow="{shadows}" attenuation="1 0 0"/>'
+              f'diffuse="{_f(*lt.rgb)}" specular="0.1 0.1 0.1" castshadow="{casts[i]}" attenuation="1 0 0"/>'
               for i, lt in enumerate(sc.lights)]
     motors = motor_positions(frame.arm_m)
     sites = "\n".join(f'      <site name="motor_{i}" pos="{_f(x, y, 0.02)}" size="0.01" group="{DRONE_GROUP}"/>'

@@ -27,7 +27,8 @@ REPO = Path(__file__).resolve().parents[3]
 def test_sim_flight_with_record(virtual_drone: Path, tmp_path: Path) -> None:
     rec = tmp_path / "rec"
     code, out, err = call(
-        "--virtual-drone", str(virtual_drone), "--scenario", "side", "--seed", "5", "--record", str(rec), "--no-status"
+        "--virtual-drone", str(virtual_drone), "--scenario", "side", "--seed", "5", "--record", str(rec), "--no-status",
+        "--ideal",  # the recording's plumbing, not the pilot's flying in the randomised world
     )
     assert code == 0, out + err
     assert "SUCCESS" in out
@@ -44,7 +45,7 @@ def _parts(frame: str) -> tuple[str, str, int]:
 
 
 def test_status_line_shows_state_target_and_rate(virtual_drone: Path) -> None:
-    code, _out, err = call("--virtual-drone", str(virtual_drone), "--scenario", "ahead", "--seed", "2")
+    code, _out, err = call("--virtual-drone", str(virtual_drone), "--scenario", "ahead", "--seed", "2", "--ideal")
     assert code == 0
     lines = [line for line in err.splitlines() if line.startswith("t ")]
     states = [line.split("state")[1].split()[0] for line in lines]

@@ -5,7 +5,6 @@ USB webcam's MJPEG)."""
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import cv2
 import numpy as np
@@ -38,11 +37,10 @@ def test_the_lights_cast_shadows_in_the_randomised_world() -> None:
     shots = []
     for effects in (Effects(), Effects(shadows=1.0)):
         sc = make_scenario("ahead", 2, ideal=True)
-        x, y, heading = sc.start
-        ahead = (x + 2.0 * math.cos(heading), y + 2.0 * math.sin(heading), 0.4)
-        cube = Prop("box", ahead, (0.4, 0.4, 0.4), (0.6, 0.6, 0.6))  # a cabinet 2 m ahead, on the floor
+        lx, ly, _ = max(sc.lights, key=lambda lt: sum(lt.rgb)).position  # the light that casts shadows
+        cube = Prop("box", (lx + 0.8, ly, 0.4), (0.4, 0.4, 0.4), (0.6, 0.6, 0.6))  # a cabinet beside it
         view = StillView(dataclasses.replace(sc, props=(cube,), effects=effects), CameraModel(160, 120))
-        view.place(x, y, 1.5, heading, tilt=60.0)  # looking down at it and the floor around it
+        view.place(lx - 1.5, ly, 1.5, 0.0, tilt=60.0)  # looking down at it and the floor behind it
         shots.append(_raw(view).astype(np.int16))
         view.close()
     darker = shots[0] - shots[1]
