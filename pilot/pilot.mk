@@ -11,7 +11,9 @@
 # BENCH_PILOT_FLAGS=--quick for a smoke run.
 
 DEMO_FLIGHT_DIR ?= build/demo-flight
-DEMO_FLIGHT_ARGS ?= --scenario behind --seed 3
+# The demo flies the ideal world: in the randomised one (the default of `pilot --sim`) the pilot does not yet cope with
+# the airframe's trim drift and this flight fails by the strict score (bench/flight/HISTORY.md).
+DEMO_FLIGHT_ARGS ?= --scenario behind --seed 3 --ideal
 BENCH_PILOT_FLAGS ?=
 PILOT_VD = $(FW_BUILD)/host/virtual_drone
 

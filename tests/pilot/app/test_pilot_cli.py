@@ -116,7 +116,8 @@ def test_missing_virtual_drone_is_explained(tmp_path: Path) -> None:
 def test_python_dash_m_pilot(virtual_drone: Path) -> None:
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(REPO), str(REPO / "generated" / "python")]))
     proc = subprocess.run(
-        [sys.executable, "-m", "pilot", "--virtual-drone", str(virtual_drone), "--scenario", "low", "--seed", "1"],
+        [sys.executable, "-m", "pilot", "--virtual-drone", str(virtual_drone), "--scenario", "low", "--seed", "1",
+         "--ideal"],
         cwd=REPO,
         env=env,
         capture_output=True,

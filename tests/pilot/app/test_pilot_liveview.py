@@ -90,7 +90,7 @@ def test_stop_in_the_browser_lands_the_simulated_drone_and_turns_the_laser_off(
     config = tmp_path / "pilot.yaml"
     config.write_text("controller:\n  fire_ms: 20000\n")  # the laser stays on until Stop
     rec = tmp_path / "rec"
-    pilot = Pilot("--virtual-drone", str(virtual_drone), "--scenario", "ahead", "--seed", "2", "--config",
+    pilot = Pilot("--virtual-drone", str(virtual_drone), "--scenario", "ahead", "--seed", "2", "--ideal", "--config",
                   str(config), "--serve", "127.0.0.1:0", "--record", str(rec), "--no-status")
     try:
         url = pilot.url()

@@ -94,7 +94,7 @@ def test_a_disk_full_mid_flight_still_lands_disarms_and_prints_the_summary(
     monkeypatch.setattr(record, "_open_log", _full_after(writes))
     config = tmp_path / "pilot.yaml"
     config.write_text(f"record_failure: {policy}\n")
-    code, out, err = call("--virtual-drone", str(virtual_drone), "--scenario", "ahead", "--seed", "2",
+    code, out, err = call("--virtual-drone", str(virtual_drone), "--scenario", "ahead", "--seed", "2", "--ideal",
                           "--record", str(tmp_path / "rec"), "--config", str(config), "--no-status",
                           "--max-seconds", "40")
     assert "Traceback" not in out + err

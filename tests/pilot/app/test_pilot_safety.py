@@ -180,7 +180,7 @@ def test_fault_in_any_stage_ends_laser_off_neutral_disarmed(stage: str, virtual_
 def test_lost_camera_lands_and_disarms(virtual_drone: Path) -> None:
     from pilot.app.sim_flight import fly
 
-    r = fly("behind", 2, lose_camera_at_s=9.0, executable=virtual_drone)
+    r = fly("behind", 2, lose_camera_at_s=9.0, executable=virtual_drone, ideal=True)
     assert r.reason.startswith("camera lost: simulated camera lost at t=9.0")
     assert r.final_state == "done"
     assert not r.final_laser and not r.final_armed and not r.final_fc_armed and r.final_altitude == 0.0
@@ -229,7 +229,7 @@ def test_pulled_cable_mid_flight_reconnects_and_lands(virtual_drone: Path, monke
                 links[-1]._port = _Unplugged(links[-1]._port)
 
     monkeypatch.setattr(flight, "Link", RecordingLink)
-    r = flight.fly("ahead", 1, observers=[Puller()], executable=virtual_drone)
+    r = flight.fly("ahead", 1, observers=[Puller()], executable=virtual_drone, ideal=True)
     assert r.reconnects == 1 and r.error is None
     assert "confirmed disarmed" in r.reason and r.final_state == "done"
     assert not r.final_laser and not r.final_armed and not r.final_fc_armed and r.final_altitude == 0.0
