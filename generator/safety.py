@@ -11,7 +11,7 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 
-from .model import Command, Spec, check_text
+from .model import Command, Direction, Spec, check_text
 
 # What a command does to safety; a command without `safety:` is routine (moves, turns, servos, holding).
 SAFETY_EFFECTS = ("arm", "disarm", "land", "laser_on", "laser_off", "laser_toggle", "self_test")
@@ -44,6 +44,7 @@ class Neighbours:
                 f"{many}{caught}")
 
 
+@functools.lru_cache(maxsize=4)
 def one_byte_neighbours(spec: Spec) -> tuple[Neighbours, ...]:
     """Every pair of commands one byte apart whose safety effects differ, in spec order."""
     out = []
@@ -66,20 +67,31 @@ def one_byte_neighbours(spec: Spec) -> tuple[Neighbours, ...]:
 
 def free_of_neighbours(spec: Spec, frame: str) -> bool:
     """Whether no single corrupted byte turns `frame` into a valid frame of another command."""
+    by_codes = _by_codes(spec)  # looked up once: hashing the spec for the cache costs more than the search
+    own = _command_of(by_codes, frame)
     for pos in range(len(frame)):
         for code in range(256):
             other = frame[:pos] + chr(code) + frame[pos + 1:]
-            if other != frame and _command_of(spec, other) not in (None, _command_of(spec, frame)):
+            if other != frame and _command_of(by_codes, other) not in (None, own):
                 return False
     return True
 
 
-def _command_of(spec: Spec, frame: str) -> str | None:
-    for c in spec.commands:
-        d = c.direction
-        if frame[:2] == c.category.code + d.code and frame[2:].isdigit() and frame[2:].isascii():
-            return d.command if d.minimum <= int(frame[2:]) <= d.maximum else None
+def _command_of(by_codes: dict[str, Direction], frame: str) -> str | None:
+    d = by_codes.get(frame[:2])
+    if d is not None and frame[2:].isdigit() and frame[2:].isascii():
+        return d.command if d.minimum <= int(frame[2:]) <= d.maximum else None
     return None
+
+
+@functools.lru_cache(maxsize=4)
+def _by_codes(spec: Spec) -> dict[str, Direction]:
+    """The first direction of each two code bytes, in spec order (built once: `spec.commands` is rebuilt on
+    every access)."""
+    out: dict[str, Direction] = {}
+    for c in spec.commands:
+        out.setdefault(c.category.code + c.direction.code, c.direction)
+    return out
 
 
 def report(spec: Spec) -> list[str]:
@@ -97,6 +109,11 @@ def report(spec: Spec) -> list[str]:
 def safe_defaults(spec: Spec) -> list[tuple[Command, str]]:
     """Commands whose default frame no single corrupted byte turns into another command while another of their
     frames is one byte from a command with another safety effect: the choice the routine traffic makes."""
+    return list(_safe_defaults(spec))
+
+
+@functools.lru_cache(maxsize=4)
+def _safe_defaults(spec: Spec) -> tuple[tuple[Command, str], ...]:
     exposed = {c.direction.command for n in one_byte_neighbours(spec) for c in (n.a, n.b)}
     out = []
     for c in spec.commands:
@@ -104,39 +121,74 @@ def safe_defaults(spec: Spec) -> list[tuple[Command, str]]:
         frame = d.frame(c.category.code, d.default_frame_value)
         if d.command in exposed and d.default is not None and free_of_neighbours(spec, frame):
             out.append((c, frame))
-    return out
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class _Group:
+    """The valid wire frames of the commands of one safety effect, stored by column (byte j of every frame) so
+    that distances are counted in C, and where each command's frames lie within the group."""
+
+    effect: str
+    columns: tuple[bytes, ...]
+    spans: dict[int, tuple[int, int]]
 
 
 @functools.lru_cache(maxsize=4)
-def _targets(spec: Spec, crc8: bool) -> tuple[tuple[bytes, int, str], ...]:
-    """Every valid frame of the spec on the wire (with its check in crc8 mode), its command's index and effect."""
+def _targets(spec: Spec, crc8: bool) -> tuple[dict[bytes, tuple[bytes, int, str]], tuple[_Group, ...]]:
+    """Every valid frame of the spec on the wire (with its check in crc8 mode) with its command's index and
+    effect, keyed by the frame with and without its check; and the same frames grouped by effect."""
     table = [int(check_text(bytes([b])), 16) for b in range(256)]
-    out = []
+    frames: dict[bytes, tuple[bytes, int, str]] = {}
+    by_effect: dict[str, tuple[list[bytes], dict[int, tuple[int, int]]]] = {}
     for c in spec.commands:
         d = c.direction
+        effect = d.safety or ROUTINE
+        wires, spans = by_effect.setdefault(effect, ([], {}))
+        first = len(wires)
         for value in range(d.minimum, d.maximum + 1):
             frame = d.frame(c.category.code, value).encode()
             crc = 0
             for byte in frame:
                 crc = table[crc ^ byte]
-            out.append((frame + b"%02X" % crc if crc8 else frame, c.index, d.safety or ROUTINE))
-    return tuple(out)
+            wire = frame + b"%02X" % crc if crc8 else frame
+            frames.setdefault(frame, (wire, c.index, effect))
+            frames.setdefault(wire, (wire, c.index, effect))
+            wires.append(wire)
+        spans[c.index] = (first, len(wires))
+    lengths = {len(w) for wires, _ in by_effect.values() for w in wires}
+    if len(lengths) > 1:
+        raise ValueError(f"wire frames of different lengths {sorted(lengths)}: no Hamming distance between them")
+    groups = tuple(_Group(effect, tuple(b"".join(wires)[j::len(wires[0])] for j in range(len(wires[0]))), spans)
+                   for effect, (wires, spans) in by_effect.items())
+    return frames, groups
+
+
+@functools.cache
+def _equal_to(byte: int) -> bytes:
+    """A translation table: 1 for `byte`, 0 for every other byte."""
+    return bytes(int(b == byte) for b in range(256))
 
 
 def substitution_rates(spec: Spec, frame: bytes, crc8: bool, q: float) -> tuple[float, float]:
     """Exact probabilities that `frame`, each of its wire bytes replaced with probability q by one of the 255
     others, arrives as another valid command, and as one with another safety effect: the sum, over every valid
     wire frame of another command at Hamming distance d, of q^d (1-q)^(n-d) / 255^d."""
-    targets = _targets(spec, crc8)
-    sent, index, effect = next(t for t in targets if t[0][:len(frame)] == frame)
+    frames, groups = _targets(spec, crc8)
+    sent, index, effect = frames[frame]
     n = len(sent)
     other = hazard = 0.0
-    for target, target_index, target_effect in targets:
-        if target_index != index:
-            k = sum(a != b for a, b in zip(sent, target, strict=True))
-            p = q ** k * (1 - q) ** (n - k) / 255 ** k
+    for group in groups:
+        # each column's equal bytes as 0/1 bytes of one integer: the sum counts each frame's equal bytes (<= n)
+        equal = sum(int.from_bytes(col.translate(_equal_to(b)), "big")
+                    for b, col in zip(sent, group.columns, strict=True))
+        counts = equal.to_bytes(len(group.columns[0]), "big")
+        first, end = group.spans.get(index, (0, 0))
+        own = counts[first:end]
+        for k in range(1, n + 1):
+            p = (counts.count(n - k) - own.count(n - k)) * (q ** k * (1 - q) ** (n - k) / 255 ** k)
             other += p
-            hazard += p * (target_effect != effect)
+            hazard += p * (group.effect != effect)
     return other, hazard
 
 

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from enum import Enum
-from typing import Final, NamedTuple, Union
 
 from .errors import (
     ERRORS,
@@ -31,7 +30,15 @@ from .tables import (
     ErrorKind,
 )
 
-BytesLike = Union[bytes, bytearray, memoryview]
+TYPE_CHECKING = False  # typing is imported for the type checker only: see tables.py
+if TYPE_CHECKING:
+    from typing import Final, NamedTuple, Union
+
+    BytesLike = Union[bytes, bytearray, memoryview]
+else:
+    from .tables import NamedTuple
+
+    BytesLike = (bytes, bytearray, memoryview)  # a tuple at run time, for isinstance()
 
 
 class Command(NamedTuple):

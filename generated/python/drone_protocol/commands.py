@@ -5,10 +5,12 @@
 
 from __future__ import annotations
 
-from typing import Final
-
 from .codec import frame_of, missing_value
 from .tables import COMMANDS, CommandName
+
+TYPE_CHECKING = False  # typing is imported for the type checker only: see tables.py
+if TYPE_CHECKING:
+    from typing import Final
 
 _MOVE_FORWARD: Final = COMMANDS[CommandName.MOVE_FORWARD]
 _MOVE_BACKWARD: Final = COMMANDS[CommandName.MOVE_BACKWARD]

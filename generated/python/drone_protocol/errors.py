@@ -7,9 +7,12 @@ have (the stream decoder counts its errors by ErrorKind instead of raising them)
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import ClassVar, Final
 
 from .tables import ErrorKind
+
+TYPE_CHECKING = False  # typing is imported for the type checker only: see tables.py
+if TYPE_CHECKING:
+    from typing import ClassVar, Final
 
 
 class ProtocolError(ValueError):

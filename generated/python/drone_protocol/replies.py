@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from typing import Final, NamedTuple
 
 from .codec import BY_BYTES, BytesLike, Command, allowed
 from .errors import ReplyError
@@ -22,6 +21,12 @@ from .tables import (
     ErrorKind,
     _TextEnum,
 )
+
+TYPE_CHECKING = False  # typing is imported for the type checker only: see tables.py
+if TYPE_CHECKING:
+    from typing import Final, NamedTuple
+else:
+    from .tables import NamedTuple
 
 
 class ReplyKind(_TextEnum):

@@ -5,10 +5,35 @@
 
 from __future__ import annotations
 
+from collections import namedtuple
 from collections.abc import Mapping
 from enum import Enum
 from types import MappingProxyType
-from typing import Final, NamedTuple, Union
+
+# typing costs about a third of the package's import time, so it is imported for the type checker only (mypy
+# treats a name TYPE_CHECKING as typing's); annotations are never evaluated (`from __future__ import annotations`).
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from typing import Final, NamedTuple, Union
+else:
+
+    class _NamedTupleMeta(type):
+        """typing.NamedTuple's class syntax at run time: the annotated names, in order, become the fields of a
+        collections.namedtuple, their values its defaults, and the rest of the body its attributes."""
+
+        def __new__(mcs, name, bases, namespace):
+            if not bases:
+                return super().__new__(mcs, name, bases, namespace)
+            fields = tuple(namespace.get("__annotations__", {}))
+            defaults = [namespace[f] for f in fields if f in namespace]
+            cls = namedtuple(name, fields, defaults=defaults, module=namespace["__module__"])
+            for key, value in namespace.items():
+                if key not in fields and key != "__module__":
+                    setattr(cls, key, value)
+            return cls
+
+    class NamedTuple(metaclass=_NamedTupleMeta):
+        """The base of the package's records (at run time; typing.NamedTuple for the type checker)."""
 
 
 class _TextEnum(str, Enum):
@@ -218,7 +243,10 @@ class InitDirection(_TextEnum):
     QUERY_STATUS = "q"
 
 
-Direction = Union[MoveDirection, TurnDirection, ServoDirection, LaserDirection, InitDirection]
+if TYPE_CHECKING:
+    Direction = Union[MoveDirection, TurnDirection, ServoDirection, LaserDirection, InitDirection]
+else:  # a tuple at run time, for isinstance()
+    Direction = (MoveDirection, TurnDirection, ServoDirection, LaserDirection, InitDirection)
 
 DIRECTIONS: Final[Mapping[Category, type[Direction]]] = MappingProxyType({
     Category.MOVE: MoveDirection,
