@@ -99,7 +99,7 @@ def variants(spec: Spec) -> list[tuple[str, str]]:
         for gap in GAPS:
             gaps = ["", SEPARATOR, SEPARATOR, SEPARATOR, ""]
             gaps[gap_index] = gap if gap_index in (1, 2, 3) else gaps[gap_index] + (gap or SEPARATOR)
-            body = gaps[0] + prefix + "".join(g + f for g, f in zip(gaps[1:4], fields, strict=True)) + gaps[4]
+            body = gaps[0] + prefix + "".join(g + f for g, f in zip(gaps[1:4], fields)) + gaps[4]
             out.append((body, f"gap {gap_index} is {gap!r}"))
     out += [
         (prefix.lower() + good[len(prefix):], "the prefix in lower case"),

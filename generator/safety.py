@@ -181,7 +181,7 @@ def substitution_rates(spec: Spec, frame: bytes, crc8: bool, q: float) -> tuple[
     for group in groups:
         # each column's equal bytes as 0/1 bytes of one integer: the sum counts each frame's equal bytes (<= n)
         equal = sum(int.from_bytes(col.translate(_equal_to(b)), "big")
-                    for b, col in zip(sent, group.columns, strict=True))
+                    for b, col in zip(sent, group.columns))
         counts = equal.to_bytes(len(group.columns[0]), "big")
         first, end = group.spans.get(index, (0, 0))
         own = counts[first:end]

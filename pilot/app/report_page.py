@@ -66,7 +66,7 @@ def timeline(f: Flight) -> str:
     states = list(dict.fromkeys(r["state"] for r in f.ticks))
     colour = {s: STATE_COLOURS[i % len(STATE_COLOURS)] for i, s in enumerate(states)}
     body = []
-    for a, b in zip(f.ticks, [*f.ticks[1:], None], strict=True):
+    for a, b in zip(f.ticks, [*f.ticks[1:], None]):
         t1 = b["t"] if b is not None else a["t"] + 0.05
         x0, x1 = _x(a["t"], f.end), _x(t1, f.end)
         body.append(f'<rect x="{x0:.1f}" y="4" width="{max(0.5, x1 - x0):.1f}" height="26" '
@@ -111,7 +111,7 @@ def laser(f: Flight) -> str:
         if pts:
             pts.append((r["t"], pts[-1][1]))
         pts.append((r["t"], v))
-    lit = sum(b["t"] - a["t"] for a, b in zip(f.ticks, f.ticks[1:], strict=False) if a.get("laser"))
+    lit = sum(b["t"] - a["t"] for a, b in zip(f.ticks, f.ticks[1:]) if a.get("laser"))
     return _line("laser", f"Laser (confirmed on {lit:.1f} s)", pts, f.end, 1.0, "on")
 
 

@@ -163,7 +163,7 @@ class Sensor:
         if e.awb_tau_s > 0.0:
             a = 1.0 if first else 1.0 - math.exp(-dt / e.awb_tau_s)
             want = [min(2.0, max(0.5, grey / max(c, 1.0))) for c in means]
-            b, g, r = (w + (v - w) * a for w, v in zip(self.white, want, strict=True))
+            b, g, r = (w + (v - w) * a for w, v in zip(self.white, want))
             self.white = (b, g, r)
 
     def _image_motion(self, t: float) -> FloatArray | None:

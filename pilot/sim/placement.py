@@ -21,7 +21,7 @@ def clearance(p: Prop, point: Vec3) -> float:
         return math.hypot(radial, max(0.0, abs(z) - p.size[1]))
     c, s = math.cos(p.yaw), math.sin(p.yaw)  # box: into its own axes
     local = (c * x + s * y, -s * x + c * y, z)
-    return math.sqrt(sum(max(0.0, abs(v) - h) ** 2 for v, h in zip(local, p.size, strict=True)))
+    return math.sqrt(sum(max(0.0, abs(v) - h) ** 2 for v, h in zip(local, p.size)))
 
 
 def check(sc: Scenario) -> None:

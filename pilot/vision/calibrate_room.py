@@ -102,7 +102,7 @@ def learn(ball: list[MatLike], room: list[MatLike], discs: list[Roi],
     """The colour model of the ball's pixels (in each frame's ``discs`` and ``ranges``) against the room's; the
     shares of the ball's and of the room's pixels it passes."""
     ball_px, room_px = [], []
-    for frame, (x, y, w, h) in zip(ball, discs, strict=True):
+    for frame, (x, y, w, h) in zip(ball, discs):
         x0, y0 = max(0, x), max(0, y)
         hsv = cv2.cvtColor(np.ascontiguousarray(frame[y0 : y + h, x0 : x + w]), cv2.COLOR_BGR2HSV)
         ball_px.append(hsv[_in_ranges(hsv, ranges)])
@@ -140,11 +140,11 @@ def learn_room(ball_paths: list[str], room_paths: list[str], config_path: str | 
                    for lo, hi in hsv_ranges_from_sample(ball[0], roi))
     discs = [ball_disc(f, roi, ranges) for f in ball]
     if sum(d is not None for d in discs) < BALL_FOUND * len(ball):
-        missed = [p for (_, p), d in zip(named, discs, strict=True) if d is None]
+        missed = [p for (_, p), d in zip(named, discs) if d is None]
         raise ConfigError(f"calibration refused: no ball of the colour {ranges} in the region of interest of "
                           f"{len(missed)} of the {len(ball)} ball frames ({', '.join(missed[:3])}): hold it in the "
                           f"middle of the view, or give --roi; nothing written")
-    kept = [(f, d) for f, d in zip(ball, discs, strict=True) if d is not None]
+    kept = [(f, d) for f, d in zip(ball, discs) if d is not None]
     model, ball_share, room_share = learn([f for f, _ in kept], room, [d for _, d in kept], ranges)
     out = model_path(config_path)
     if room_share > ROOM_PIXELS:

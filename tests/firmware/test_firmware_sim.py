@@ -131,8 +131,11 @@ def test_every_valid_vector_gives_its_pulses_and_reply() -> None:
         plan.check(model.widths(), model.laser, [fw.R.accepted(frame)], v["frame"])
         plan.wait(SLOT_MS)
     init = {v["command"]: bytes.fromhex(v["frame_hex"]) for v in by_category["i"]}
-    assert set(init) == {"arm", "disarm", "hold_altitude", "first_test", "land"}, \
+    assert set(init) == {"arm", "disarm", "hold_altitude", "first_test", "land", "query_status"}, \
         "a new init routine needs a check here"
+    plan.send(init["query_status"])  # changes nothing
+    plan.check(model.widths(), model.laser, [fw.R.accepted(init["query_status"])], "iq")
+    plan.wait(SLOT_MS)
     plan.send(init["hold_altitude"])
     plan.check(model.widths(), model.laser, [fw.R.accepted(init["hold_altitude"])], "is")
     plan.wait(SLOT_MS)

@@ -1,9 +1,7 @@
-"""The status query (iq0000) on the host build and on the real AVR binary in simavr: accepted in every state with
-the state and laser as they are, and no output changes; it is a sign of life for the failsafe but neither holds a
-movement past the command timeout nor ends a failsafe (the next real frame does).
-
-Expected reply lines come from the spec's model (fwsupport.Replies); timings from the generated module.
-"""
+"""The status query (query_status, iq0002) on the host build and on the real AVR binary in simavr: accepted in every
+state with the state and laser as they are, and no output changes; it is a sign of life for the failsafe but neither
+holds a movement past the command timeout nor ends a failsafe (the next real frame does). Expected reply lines come
+from the spec's model (fwsupport.Replies); timings from the generated module."""
 
 from __future__ import annotations
 

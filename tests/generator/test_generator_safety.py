@@ -51,10 +51,12 @@ def test_every_reported_example_is_two_valid_frames_one_byte_apart() -> None:
 
 
 def test_the_pilots_routine_frames_have_no_valid_one_byte_neighbour() -> None:
-    """The keep-alive and neutral command (hold_altitude) and laser_off as the pilot sends them (defaults)."""
+    """The keep-alive and neutral command (hold_altitude), laser_off and the status poll as the pilot sends them."""
     for frame in (dp.hold_altitude(), dp.laser_off()):
         assert {c.name for c in corruptions(frame)} == {dp.decode(frame).name}, frame  # only its other form
         assert free_of_neighbours(load_spec(SPEC), frame.decode())
+    # the status poll, sent every tick while the pilot waits for a confirmation, has no valid neighbour at all
+    assert not list(corruptions(dp.query_status())) and free_of_neighbours(load_spec(SPEC), dp.query_status().decode())
     # the seed's forms are still accepted, and are exposed: one byte from a landing, and from the laser on
     assert {c.name.value for c in corruptions(dp.hold_altitude(0))} >= {"land", "arm", "disarm"}
     assert "laser_on" in {c.name.value for c in corruptions(dp.laser_off(0))}

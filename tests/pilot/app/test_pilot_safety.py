@@ -45,7 +45,7 @@ def fly_and_fault(stage: str, exe: Path) -> Flight:
     """Fly the simulated room with the real virtual drone; once the laser is on (FIRE), make
     ``stage`` fail (or deliver the signal)."""
     cfg = PilotConfig()
-    scenario = make_scenario("ahead", 1)
+    scenario = make_scenario("ahead", 1, ideal=True)  # the loop's safety, not flying the randomised world
     vd = VirtualDrone(exe)
     world = SimWorld(scenario, vd)
     link = sim_link(world, vd, cfg.link).open()
