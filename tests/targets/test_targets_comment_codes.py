@@ -5,6 +5,7 @@ broken and TypeScript's `tsc` failing on them)."""
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
@@ -23,6 +24,7 @@ def tree() -> Path:
     out = t.BUILD / "comment_codes"
     out.mkdir(parents=True, exist_ok=True)
     (out / "drone.yaml").write_text(yaml.safe_dump(spec, allow_unicode=True, sort_keys=False), encoding="utf-8")
+    shutil.rmtree(out / "generated", ignore_errors=True)  # a fresh codec: no earlier run's contract to rise from
     assert generate(["--spec", str(out / "drone.yaml"), "--out", str(out / "generated")]) == 0
     return out / "generated"
 
