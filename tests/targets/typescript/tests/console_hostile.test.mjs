@@ -37,7 +37,8 @@ before(async () => {
   writeFileSync(join(dir, "drone.yaml"), spec);
   execFileSync(PYTHON, ["-m", "generator", "--spec", join(dir, "drone.yaml"), "--out", join(dir, "out")], { cwd: ROOT });
   const pkg = join(dir, "out/typescript");
-  execFileSync(TSC, ["-p", join(pkg, "tsconfig.json")]);
+  execFileSync(TSC, ["-p", join(pkg, "tsconfig.json")]);  // the package's own build: ES modules, CommonJS, console
+  execFileSync(TSC, ["-p", join(pkg, "tsconfig.cjs.json")]);
   execFileSync("node", [join(pkg, "scripts/build-console.mjs")], { cwd: pkg });
   context = await chromium.launchPersistentContext(join(dir, "profile"), {
     executablePath: CHROMIUM, args: FLAGS, headless: true,
