@@ -1,4 +1,7 @@
-"""Fixtures of the pilot tests: the real virtual drone, built from the firmware sources for this run."""
+"""Fixtures of the pilot tests: the real virtual drone, built from the firmware sources for this run, and a frozen
+clock for the detectors' per-frame budget (``vision.budget_ms``): it never runs out in these tests unless a test
+gives a detector a clock of its own (test_pilot_budget.py), so a loaded machine cannot change what a detector
+sees, nor therefore the path of a flight that a test judges."""
 
 from __future__ import annotations
 
@@ -8,7 +11,14 @@ from pathlib import Path
 
 import pytest
 
+import pilot.vision.budget as budget
+
 REPO = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(autouse=True)
+def frozen_budget_clock(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(budget, "CLOCK", lambda: 0.0)
 
 
 @pytest.fixture(scope="session")
