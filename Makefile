@@ -67,7 +67,7 @@ pythons:
 	  { echo "Python $$v is missing: install pyenv (https://github.com/pyenv/pyenv) and run  pyenv install $$v"; exit 1; }; done
 
 pytest: deps pythons
-	$(PY) -m pytest -q -n 2 --dist loadgroup tests
+	$(PY) -m pytest -q -n 2 --dist loadgroup --no-loadscope-reorder tests
 
 test: deps check-generated lint typecheck pytest fuzz-smoke
 

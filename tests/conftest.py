@@ -1,8 +1,10 @@
-"""Two groups for pytest-xdist (`make test` runs `-n 2 --dist loadgroup`): the pilot's tests, which fly the
-simulator and build their own virtual drone in a temporary folder, on one worker; everything else, whose
-tests share the build folders of the repo (firmware/build, build/tests, build/targets), on the other, in turn.
-The pilot's tests that only run its detector on photographs (no flight, no build) join the second group: the
-flights alone took 300 s of a run, everything else 180 s."""
+"""Groups for pytest-xdist (`make test` runs `-n 2 --dist loadgroup --no-loadscope-reorder`): every test outside
+tests/pilot shares the build folders of the repo (firmware/build, build/tests, build/targets) and so runs in one
+group, in turn, on one worker; the pilot's tests build their own virtual drone in a temporary folder and share
+nothing, so each of their files is a group of its own that either worker takes when it runs out of work. The
+groups start longest first: the closed-loop flights (a fifth of a run) on one worker, the shared builds (the
+largest group) on the other, then the pilot's files that take longest (LONGEST_FIRST), then the rest; a worker
+that started the flights last would finish minutes after the other."""
 
 from __future__ import annotations
 
@@ -12,7 +14,9 @@ from pathlib import Path
 import pytest
 
 TESTS = Path(__file__).resolve().parent
-DETECTOR_ONLY = ("test_pilot_hsv_", "test_pilot_vision", "test_pilot_noise", "test_pilot_detect")  # file names
+FIRST = "test_pilot_closed_loop.py"
+LONGEST_FIRST = ("test_pilot_hsv_hollow.py", "test_pilot_safety.py",
+                 "test_pilot_exits.py", "test_pilot_hsv_inside.py", "test_pilot_hsv_measured_again.py")
 
 
 def pytest_configure(config: pytest.Config) -> None:
@@ -26,8 +30,18 @@ def pytest_configure(config: pytest.Config) -> None:
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
         folder = item.path.resolve().relative_to(TESTS).parts[0]
-        flies = folder == "pilot" and not item.path.name.startswith(DETECTOR_ONLY)
-        item.add_marker(pytest.mark.xdist_group("pilot" if flies else "shared-builds"))
+        group = f"pilot-{item.path.stem}" if folder == "pilot" else "shared-builds"
+        item.add_marker(pytest.mark.xdist_group(group))
+
+    def rank(item: pytest.Item) -> int:  # a stable sort: within a rank, the order pytest collected
+        name = item.path.name
+        if name == FIRST:
+            return 0
+        if not name.startswith("test_pilot_"):
+            return 1
+        return 2 + (LONGEST_FIRST.index(name) if name in LONGEST_FIRST else len(LONGEST_FIRST))
+
+    items.sort(key=rank)
 
 
 def pytest_collection_finish(session: pytest.Session) -> None:
