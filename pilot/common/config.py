@@ -6,7 +6,6 @@ Every error names the offending option by its dotted path (``controller.fire_ms`
 from __future__ import annotations
 
 import dataclasses
-import math
 import reprlib
 import typing
 from dataclasses import dataclass, field
@@ -17,6 +16,7 @@ import drone_protocol as dp
 import yaml
 
 from .errors import ConfigError
+from .ranges import within
 
 HsvTriple = tuple[int, int, int]
 HsvRange = tuple[HsvTriple, HsvTriple]
@@ -245,9 +245,7 @@ def _option(config: PilotConfig, path: str) -> Any:
 
 def _check_ranges(config: PilotConfig, where: str) -> None:
     for path, (low, high) in RANGES.items():
-        value = _option(config, path)
-        if not (math.isfinite(value) and low <= value <= high):  # NaN and infinities fail here
-            raise ConfigError(f"{where}: option {_show(path)} must be within {low:g}..{high:g}, got {_show(value)}")
+        _in(where, path, _option(config, path), low, high)
 
 
 def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
@@ -288,7 +286,7 @@ def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
 
 
 def _in(where: str, option: str, value: float, lo: float, hi: float) -> None:
-    if not lo <= value <= hi:
+    if not within(value, lo, hi):
         raise ConfigError(f"{where}: option {option!r} must be within {lo:g}..{hi:g}, got {_show(value)}")
 
 
