@@ -290,12 +290,22 @@ def _in(where: str, option: str, value: float, lo: float, hi: float) -> None:
         raise ConfigError(f"{where}: option {option!r} must be within {lo:g}..{hi:g}, got {_show(value)}")
 
 
+def _aruco_dictionary_known(name: str) -> bool:
+    import cv2  # here, not at the top: importing the config stays free of OpenCV (about 0.2 s)
+
+    return name.startswith("DICT_") and isinstance(getattr(cv2.aruco, name, None), int)
+
+
 def _validate_vision(config: PilotConfig, where: str) -> None:
     h, v, c = config.hsv, config.vision, config.controller
     _in(where, "hsv.target_diameter_m", h.target_diameter_m, 0.01, 5.0)
     _in(where, "hsv.min_score", h.min_score, 0.0, 1.0)
     _in(where, "hsv.min_area", h.min_area, 4, 1_000_000)
     _in(where, "aruco.marker_size_m", config.aruco.marker_size_m, 0.01, 5.0)
+    if not _aruco_dictionary_known(config.aruco.dictionary):  # checked whichever detector flies: a typo waits
+        raise ConfigError(f"{where}: option 'aruco.dictionary' must be one of OpenCV's predefined ArUco "
+                          f"dictionaries (DICT_4X4_50, DICT_6X6_250, DICT_APRILTAG_36h11, ...), got "
+                          f"{_show(config.aruco.dictionary)}")
     _in(where, "vision.range_min_m", v.range_min_m, 0.0, 100.0)
     _in(where, "vision.range_max_m", v.range_max_m, v.range_min_m + 0.1, 1000.0)
     _in(where, "vision.bridge_frames", v.bridge_frames, 0, 30)
