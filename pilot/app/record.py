@@ -72,8 +72,10 @@ def summary_lines(directory: str | Path, failed: str, *, simulated: bool, pictur
     (``failed`` says why), that its files end there; the path picture of a simulated flight, or why there is none.
     Never a path that was not written."""
     video, log = Path(directory) / VIDEO, Path(directory) / LOG
-    lines = [f"recording: stopped early ({failed}); {video} and {log} end there" if failed
-             else f"recording: {video}\nlog:       {log}"]
+    if failed:
+        lines = [f"recording: stopped early ({failed}); {video} and {log} end there"]
+    else:
+        lines = [f"recording: {video}", f"log:       {log}"]
     if simulated:
         lines.append(f"path:      {picture}" if picture else "path:      not drawn: the recording had stopped")
     return lines

@@ -83,8 +83,8 @@ def test_the_links_log_is_bounded_and_a_failing_subscriber_is_dropped(capfd: pyt
 def test_the_summary_names_the_files_of_a_recording_or_says_why_it_ended(tmp_path: Path) -> None:
     video, log, picture = tmp_path / "flight.avi", tmp_path / "log.jsonl", str(tmp_path / "path.png")
     assert record.summary_lines(tmp_path, "", simulated=True, picture=picture) == [
-        f"recording: {video}\nlog:       {log}", f"path:      {picture}"]
-    assert record.summary_lines(tmp_path, "", simulated=False) == [f"recording: {video}\nlog:       {log}"]
+        f"recording: {video}", f"log:       {log}", f"path:      {picture}"]
+    assert record.summary_lines(tmp_path, "", simulated=False) == [f"recording: {video}", f"log:       {log}"]
     stopped = f"recording: stopped early ({log}: No space left on device); {video} and {log} end there"
     assert record.summary_lines(tmp_path, f"{log}: No space left on device", simulated=True) == [
         stopped, "path:      not drawn: the recording had stopped"]
