@@ -1,4 +1,4 @@
-// libFuzzer target for the generated DroneProtocol.h: StreamParser, decode and encode.
+// libFuzzer target for the generated DroneProtocol.h: StreamParser, decode, encode and parse_reply.
 //
 // Input: a byte stream fed to a StreamParser one byte at a time. 0xFF n advances the clock by n ms (0xFF 0xFF
 // feeds 0xFF itself), so inter-byte timeouts are explored too. The same input also drives decode() on every
