@@ -1,19 +1,8 @@
 """Lossy-link bench (``make bench-lossy``, or ``python -m bench.lossy.run``): the pilot flies the simulated
-room against the virtual drone through a proxy (a pty pair, bench/lossy/proxy.py) that drops, inserts and flips
-bytes at 0/1/2/10 % per byte, in both directions. Per flight, measured on the virtual drone's outputs
-millisecond by millisecond against the pilot's state at that moment:
-
-* laser-on outside the pilot's fire state: ms the laser pin is high while the pilot does not want it lit, in
-  episodes; each episode is allowed one reply round trip (one tick) plus one per damaged byte on the link
-  during it; the excess beyond that is the figure (goal 0 ms);
-* arming-state disagreements: intervals where the pilot's view (from the replies' status) says armed and the
-  firmware is not, or the reverse (count, longest; goal: none over 200 ms);
-* flights completed: the spot on the target without a break for the fire time, the fire completed, and the run
-  ended with the drone confirming laser off and disarmed.
-
-With ``--integrity crc8`` a copy of the spec with ``frame.integrity: crc8`` is generated into a temporary folder,
-the virtual drone is built from it, and the flights run in a child process that imports that codec.
-Figures go to bench/lossy/RESULTS.md (and the README's table is copied from it).
+room against the virtual drone through a proxy (bench/lossy/proxy.py) that drops, inserts and flips bytes, and
+each flight is measured on the virtual drone's outputs against the pilot's state: laser-on outside the fire
+state, arming-state disagreements, flights completed. bench/lossy/README.md defines each figure and its goal;
+``--integrity crc8`` flies a crc8 copy of the spec in a child process. Writes bench/lossy/RESULTS.md.
 """
 
 from __future__ import annotations

@@ -2,19 +2,10 @@
 
     python -m bench.protocol.run [--quick] [--build DIR] [--results FILE | --no-write] [--only SECTION ...]
 
-Sections:
-  python     encode/decode per message of the generated `drone_protocol` against a bare f-string formatter and a
-             bare slice-and-int parser (target: within 2x)
-  host       C++ StreamParser + dispatch throughput (g++ -O2) and instructions per frame (callgrind) against a
-             naive fixed-6-byte atoi loop in the same program
-  avr        flash and RAM of the parser + dispatch for the ATmega328P (avr-g++ -Os): a tiny avr-libc sketch
-             built with and without it (target: under 1 KB flash, under 32 bytes RAM)
-
-The generator's own run time is bench/generator's (make bench-generator).
-
-Times on a shared machine are noisy: Python figures are best-of-N per message and the median of paired ratios
-(baseline and subject timed back to back, alternating order); process timings are medians; instruction counts
-and sizes are exact. Prints one table and writes it, with the environment, to bench/protocol/RESULTS.md.
+Sections: ``python`` (the generated codec against bare f-string and slice-and-int code), ``host`` (the C++
+StreamParser and dispatch against a fixed 6-byte atoi loop, timed and counted by callgrind) and ``avr`` (the
+parser's flash and RAM on the ATmega328P). Writes the table, the environment and how each figure is measured
+(METHOD below) to bench/protocol/RESULTS.md.
 """
 
 from __future__ import annotations

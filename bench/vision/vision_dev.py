@@ -1,24 +1,12 @@
 """The dev seed sets of bench/vision: where a change to the colour-ball detector is measured before a report run.
 
-bench/vision/HISTORY.md gives, for each change since the twenty-fifth session, the balls it gained and lost and the
-false detections it added on these sets. They use the tuning and validation photos, never the held-out or bench
-photos (the report's veto), and never the report's seeds (run.py: 1, 2, 5, 9):
+Record the code as it is, change it, record again and compare (``make bench-vision-dev`` records as ``current``)::
 
-* five target sets: tuning seeds 21, 31 and 81, validation seeds 25 and 83. Each has 250 views per condition, 500
-  empty views and 50 per distractor kind, 3,750 views in all;
-* five sets of further negatives (12,000 views): 1,000 empty and 2,000 distractor views each on tuning seeds 91 and
-  93 and on validation seed 92, and 1,500 red shapes each on tuning seed 95 and validation seed 96.
-
-Record the code as it is, change it, record again and compare (``make bench-vision-dev`` records as
-``current``, or as ``VISION_DEV_RECORD``)::
-
-    PYTHONPATH=.:bench/vision .venv/bin/python bench/vision/vision_dev.py record before
-    PYTHONPATH=.:bench/vision .venv/bin/python bench/vision/vision_dev.py record after
+    PYTHONPATH=.:bench/vision .venv/bin/python bench/vision/vision_dev.py record before  # about 3 min, 2 cores
     PYTHONPATH=.:bench/vision .venv/bin/python bench/vision/vision_dev.py compare before after
 
-A record keeps every candidate of every view, in build/vision-dev/<name>/<set>.json. Recording takes about 3 minutes
-on 2 cores; ``record NAME --sets tun val ...`` records some sets only, and ``compare`` reads the sets both records
-hold.
+The sets (``TARGET_SETS``, ``NEGATIVE_SETS``, ``SHAPE_SETS``; bench/vision/HISTORY.md describes them) use the tuning
+and validation photos only, never the held-out or bench photos nor the report's seeds.
 """
 
 from __future__ import annotations

@@ -17,7 +17,6 @@ import dataclasses
 import signal
 import sys
 from collections.abc import Sequence
-from pathlib import Path
 from types import FrameType
 from typing import TYPE_CHECKING
 
@@ -37,7 +36,7 @@ from ..vision.picam import PicameraSource
 from .cli_options import MAX_VIEWERS, LiveSession, check_sources, port_error_hint, stop_note
 from .liveserver import DEFAULT_LIMITS
 from .observers import LaserTally
-from .record import Recorder
+from .record import Recorder, summary_lines
 from .runner import DryRunSink, Observer, RealPacer, Sink, StatusLine, run
 
 if TYPE_CHECKING:
@@ -222,9 +221,8 @@ def _fly_sim(args: argparse.Namespace, cfg: PilotConfig) -> int:
     print(f"drone:     laser {'ON' if result.final_laser else 'off'}, {'armed' if result.final_armed else 'disarmed'}, "
           f"altitude {result.final_altitude:.2f} m (the virtual drone's outputs at the end)")
     if result.record_dir:
-        print(f"recording: {result.video}")
-        print(f"log:       {Path(result.record_dir) / 'log.jsonl'}")
-        print(f"path:      {result.path_picture}")
+        print("\n".join(summary_lines(result.record_dir, result.record_failed, simulated=True,
+                                       picture=result.path_picture)))
     if result.error:
         print(f"pilot: stopped by {result.error}", file=sys.stderr)
     if result.error and ("KeyboardInterrupt" in result.error or "StopRequested" in result.error):
@@ -336,7 +334,7 @@ def _fly_real(args: argparse.Namespace, cfg: PilotConfig) -> int:
     for problem in result.shutdown_errors:
         print(f"pilot: during the safe shutdown: {problem}", file=sys.stderr)
     if recorder is not None:
-        print(f"recording: {recorder.video_path}\nlog:       {recorder.log_path}")
+        print("\n".join(summary_lines(recorder.dir, recorder.failed, simulated=False)))
     if isinstance(result.error, KeyboardInterrupt):
         return EXIT_INTERRUPTED
     if result.error is not None and not isinstance(result.error, PilotError):

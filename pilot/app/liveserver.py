@@ -1,21 +1,9 @@
 """The live view's HTTP server: one thread, non-blocking sockets, every resource bounded.
 
-The pilot loop must never wait for a browser (the firmware's failsafe fires after a second without a frame),
-so the server runs in a single thread over a selector, and each client costs a socket and at most one
-frame of output:
-
-* at most ``Limits.viewers`` MJPEG streams (503 past that) and ``Limits.connections`` sockets; a new
-  connection at the limit closes the oldest one that is not a stream, so idle sockets cannot lock out Stop;
-* a client has ``request_s`` to send its request, and a response or stream that takes no byte for
-  ``stall_s`` is closed;
-* a frame is offered to a stream only once its previous frame is fully sent: a slow viewer misses frames,
-  nothing queues;
-* new connections are accepted at a bounded rate (the rest wait in the kernel's backlog), so a flood of
-  connections costs the pilot's process a bounded share of its time;
-* a client's error (a reset, a bad request, a timeout) is one log line, at most one a second (the
-  rest counted in the next line).
+The pilot loop must never wait for a browser (the firmware's failsafe fires after a second without a frame), so
+the server runs in a single thread over a selector and each client costs a socket and at most one frame of
+output; ``Limits`` holds the bounds, and a client's error is one log line, at most one a second.
 """
-
 from __future__ import annotations
 
 import contextlib
@@ -31,6 +19,10 @@ from ..common.errors import PilotError
 
 @dataclass(frozen=True)
 class Limits:
+    """What the server lets its clients take. At the socket limit a new connection closes the oldest one that is
+    not a stream, so idle sockets cannot lock out Stop; a stream is offered a frame only once its previous one is
+    fully sent, so a slow viewer misses frames and nothing queues."""
+
     viewers: int = 4  # MJPEG streams at once: a 20 Hz stream is about 0.5 MB/s
     connections: int = 32  # sockets at once (pages, state polls, Stop, streams)
     request_s: float = 5.0  # to send a whole request

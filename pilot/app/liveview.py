@@ -1,20 +1,9 @@
 """``--serve HOST:PORT``: a live view of the flight in a browser, with an emergency Stop.
 
-A single-threaded, non-blocking server (``liveserver.py``: bounded viewers and sockets, timeouts, frames
-dropped for a slow viewer, client errors as one line). Every path starts with a random token printed at
-start-up (``http://127.0.0.1:8080/<token>/``); anything else is 404, so the page and its Stop need the URL.
-
-* ``/<token>/``             the page (``liveview.html``)
-* ``/<token>/stream.mjpg``  the annotated frames, MJPEG (``multipart/x-mixed-replace``); each part carries
-                            ``X-Capture-Ms``, the frame's arrival (Unix ms), so the page can show its latency
-* ``/<token>/state.json``   state, detection and confidence, laser, the last commands and replies, link health
-* ``POST /<token>/stop``    asks the pilot to stop: the loop's next tick raises ``StopRequested`` and the
-                            pilot runs its safe sequence (laser off, land, disarm), as after Ctrl-C
-
-The pilot loop only stores a reference to the newest tick under a short lock (the sources hand out a new
-image per frame); the server's thread draws the overlay and encodes each frame once, off the control loop.
+Served by ``liveserver.py`` under a random token printed at start-up (``http://127.0.0.1:8080/<token>/``), so the
+page and its Stop need the URL. The pilot loop only stores a reference to the newest tick under a short lock; the
+server's thread draws the overlay and encodes each frame once, off the control loop.
 """
-
 from __future__ import annotations
 
 import json
@@ -178,6 +167,14 @@ class LiveView:
         return self._encoded
 
     def _handle(self, method: str, target: str, client: str) -> Response | Stream:
+        """The routes; any other path is 404.
+
+        * ``/<token>/``             the page (``liveview.html``)
+        * ``/<token>/stream.mjpg``  the annotated frames, MJPEG (``multipart/x-mixed-replace``); each part carries
+                                    ``X-Capture-Ms``, the frame's arrival (Unix ms), so the page shows its latency
+        * ``/<token>/state.json``   state, detection and confidence, laser, the last commands and replies, link health
+        * ``POST /<token>/stop``    the loop's next tick raises ``StopRequested`` and the pilot runs its safe
+                                    sequence (laser off, land, disarm), as after Ctrl-C"""
         prefix = f"/{self.token}/"
         path = target.split("?", 1)[0]
         route = "" if path == prefix.rstrip("/") else (path[len(prefix):] if path.startswith(prefix) else None)

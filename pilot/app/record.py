@@ -67,6 +67,20 @@ def prepare_directory(directory: str | Path, force: bool = False) -> Path:
     return path
 
 
+def summary_lines(directory: str | Path, failed: str, *, simulated: bool, picture: str | None = None) -> list[str]:
+    """The flight summary's lines about a recording in ``directory``: its files, or, when it stopped early
+    (``failed`` says why), that its files end there; the path picture of a simulated flight, or why there is none.
+    Never a path that was not written."""
+    video, log = Path(directory) / VIDEO, Path(directory) / LOG
+    if failed:
+        lines = [f"recording: stopped early ({failed}); {video} and {log} end there"]
+    else:
+        lines = [f"recording: {video}", f"log:       {log}"]
+    if simulated:
+        lines.append(f"path:      {picture}" if picture else "path:      not drawn: the recording had stopped")
+    return lines
+
+
 def _reply_text(reply: dp.Reply) -> str:
     return reply.kind.name + (reply.category or "") + (reply.direction or "") + (reply.error or "")
 

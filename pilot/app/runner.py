@@ -1,21 +1,10 @@
 """The pilot loop: frame -> detection -> decision -> wire, at a steady tick, and the safe way out.
 
-The same loop flies the real drone (a camera, a serial link, wall-clock pacing) and the simulated
-one (the simulated camera, the virtual drone's pty, the world's stepped clock as the pacer).
-
-Each tick reads the replies first (the pilot's view of the drone is what they confirm), then decides and
-sends one frame (a status poll ``POLL_COPIES`` times: each copy gets its own reply).
-
-Safety: whatever ends the loop — the mission done, the time limit, the end of a video, a lost camera,
-Ctrl-C/SIGTERM (``KeyboardInterrupt``), or an exception in any stage (source, detector, controller,
-link, observers) — the controller lands before ``run`` returns, one frame per tick: laser off until
-confirmed, servos home, the firmware's landing routine, keep-alives until the drone confirms it is not
-armed (or the landing time passes). A second Ctrl-C/SIGTERM while landing cuts that to the shortest
-sequence the firmware accepts (laser off, land, until confirmed disarmed, or no answer for the failsafe
-time); a third stops sending at once. A lost serial port ends the run at once: nothing can reach the
-drone, and the result says when its failsafe fires.
+The same loop flies the real drone (a camera, a serial link, wall-clock pacing) and the simulated one (the
+simulated camera, the virtual drone's pty, the world's stepped clock as the pacer). Each tick reads the replies
+first (the pilot's view of the drone is what they confirm), then decides and sends one frame; whatever ends the
+loop, ``run`` lands before it returns.
 """
-
 from __future__ import annotations
 
 import math
@@ -180,6 +169,15 @@ def run(
     observers: Iterable[Observer] = (),
     wall_clock: Callable[[], float] = time.perf_counter,
 ) -> RunResult:
+    """Fly until the mission, the time limit or the frames end, then land.
+
+    Whatever ends the loop (also a lost camera, Ctrl-C/SIGTERM as ``KeyboardInterrupt``, or an exception in the
+    source, detector, controller, link or an observer), the controller lands before this returns, one frame per
+    tick: laser off until confirmed, servos home, the firmware's landing routine, keep-alives until the drone
+    confirms it is not armed (or the landing time passes). A second Ctrl-C/SIGTERM while landing cuts that to the
+    shortest sequence the firmware accepts (laser off, land, until confirmed disarmed, or no answer for the
+    failsafe time); a third stops sending at once. A lost serial port ends the run at once: nothing can reach the
+    drone, and the result says when its failsafe fires."""
     watchers = list(observers)
     start = pacer.now()
     link = _LinkState(pacer.now())

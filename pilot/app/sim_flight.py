@@ -85,6 +85,7 @@ class FlightResult:
     record_dir: str | None = None
     path_picture: str | None = None
     video: str | None = None
+    record_failed: str = ""  # why the recording stopped early, if it did
     error: str | None = None
     physics_ms: float = 0.0  # wall time in physics and the flight controller
     render_ms: float = 0.0  # wall time in MuJoCo's renderer
@@ -233,6 +234,7 @@ def fly(
                         }
                     }
                 )
+                recorder.close()  # now: a last flush that fails is in the result's record_failed
             error = None if result.error is None else f"{type(result.error).__name__}: {result.error}"
             fire_ms = cfg.controller.fire_ms
             failed = failures(
@@ -267,6 +269,7 @@ def fly(
                 record_dir=str(recorder.dir) if recorder is not None else None,
                 path_picture=picture,
                 video=str(recorder.video_path) if recorder is not None else None,
+                record_failed=recorder.failed if recorder is not None else "",
                 physics_ms=score.physics_ms,
                 render_ms=score.render_ms,
                 sensor_ms=score.sensor_ms,

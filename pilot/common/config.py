@@ -6,7 +6,6 @@ Every error names the offending option by its dotted path (``controller.fire_ms`
 from __future__ import annotations
 
 import dataclasses
-import math
 import reprlib
 import typing
 from dataclasses import dataclass, field
@@ -17,6 +16,7 @@ import drone_protocol as dp
 import yaml
 
 from .errors import ConfigError
+from .ranges import within
 
 HsvTriple = tuple[int, int, int]
 HsvRange = tuple[HsvTriple, HsvTriple]
@@ -245,9 +245,7 @@ def _option(config: PilotConfig, path: str) -> Any:
 
 def _check_ranges(config: PilotConfig, where: str) -> None:
     for path, (low, high) in RANGES.items():
-        value = _option(config, path)
-        if not (math.isfinite(value) and low <= value <= high):  # NaN and infinities fail here
-            raise ConfigError(f"{where}: option {_show(path)} must be within {low:g}..{high:g}, got {_show(value)}")
+        _in(where, path, _option(config, path), low, high)
 
 
 def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
@@ -288,8 +286,14 @@ def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
 
 
 def _in(where: str, option: str, value: float, lo: float, hi: float) -> None:
-    if not lo <= value <= hi:
+    if not within(value, lo, hi):
         raise ConfigError(f"{where}: option {option!r} must be within {lo:g}..{hi:g}, got {_show(value)}")
+
+
+def _aruco_dictionary_known(name: str) -> bool:
+    import cv2  # here, not at the top: importing the config stays free of OpenCV (about 0.2 s)
+
+    return name.startswith("DICT_") and isinstance(getattr(cv2.aruco, name, None), int)
 
 
 def _validate_vision(config: PilotConfig, where: str) -> None:
@@ -298,6 +302,10 @@ def _validate_vision(config: PilotConfig, where: str) -> None:
     _in(where, "hsv.min_score", h.min_score, 0.0, 1.0)
     _in(where, "hsv.min_area", h.min_area, 4, 1_000_000)
     _in(where, "aruco.marker_size_m", config.aruco.marker_size_m, 0.01, 5.0)
+    if not _aruco_dictionary_known(config.aruco.dictionary):  # checked whichever detector flies: a typo waits
+        raise ConfigError(f"{where}: option 'aruco.dictionary' must be one of OpenCV's predefined ArUco "
+                          f"dictionaries (DICT_4X4_50, DICT_6X6_250, DICT_APRILTAG_36h11, ...), got "
+                          f"{_show(config.aruco.dictionary)}")
     _in(where, "vision.range_min_m", v.range_min_m, 0.0, 100.0)
     _in(where, "vision.range_max_m", v.range_max_m, v.range_min_m + 0.1, 1000.0)
     _in(where, "vision.bridge_frames", v.bridge_frames, 0, 30)

@@ -1,20 +1,10 @@
 """An emulation of ArduCopter's Stabilize, AltHold and Land modes, stick arming and radio failsafe.
 
-It reads only the RC pulses (as the real flight controller does) and the airframe's attitude, rates and
-height, and returns four motor thrusts. What it reproduces, with ArduCopter's parameter names (``rc.py``):
-
-* roll/pitch stick -> lean angle, linear up to ``ANGLE_MAX`` with a circular limit, shaped by a first-order
-  filter of ``ATC_INPUT_TC``; a released stick levels the airframe and nothing holds position: it coasts;
-* yaw stick -> yaw rate up to ``PILOT_Y_RATE``, reached at no more than ``ATC_ACCEL_Y_MAX``;
-* Stabilize: throttle -> collective, mid-stick at ``MOT_THST_HOVER`` (ArduCopter's throttle curve);
-* AltHold: throttle -> climb rate with the ``THR_DZ`` dead band around mid-stick, up to ``PILOT_SPEED_UP`` /
-  ``PILOT_SPEED_DN`` with ``PILOT_ACCEL_Z``, and the altitude held when centred;
-* arming with throttle at zero and yaw right held ``ARM_DELAY_S``; disarming likewise with yaw left, landed only;
-* radio failsafe (throttle below ``FS_THR_VALUE``): disarm when landed, else Land (RTL falls back to Land
-  indoors without GPS) at ``LAND_SPEED``, and disarm on touchdown;
-* the crash check: an attitude off its target by more than 30° for 2 s disarms.
-
-Angles here are ArduCopter's (roll right, pitch nose-up and yaw clockwise positive); ``physics.py`` converts.
+It reads only the RC pulses (as the real flight controller does) and the airframe's attitude, rates and height,
+and returns four motor thrusts, with ArduCopter's parameter names (``rc.py``); pilot/README.md ("The simulator")
+says what each stick and mode does. An attitude off its target by more than 30° for 2 s disarms, as ArduCopter's
+crash check does. Angles here are ArduCopter's (roll right, pitch nose-up and yaw clockwise positive);
+``physics.py`` converts.
 """
 
 from __future__ import annotations

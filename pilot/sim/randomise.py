@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..common.errors import ConfigError
+from ..common.ranges import within
 
 # field -> (lowest, highest) physically meaningful value, and the unit in messages
 RANGES: dict[str, tuple[float, float, str]] = {
@@ -97,7 +98,7 @@ class Effects:
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
             lo, hi, unit = RANGES[f.name]
-            if not (isinstance(value, (int, float)) and lo <= value <= hi):  # NaN fails both comparisons
+            if not within(value, lo, hi):
                 raise ConfigError(f"simulator parameter {f.name} = {value!r}: outside its physical range "
                                   f"{lo:g}..{hi:g} {unit}")
 

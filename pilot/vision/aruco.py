@@ -1,26 +1,10 @@
 """The ArUco marker detector, with parameters for the frames a drone sees: blur, the frame's edge, dim light.
 
-Each was chosen on the tuning photos of bench/vision (RESULTS.md has the figures), for recall under motion
-blur and at the frame's edge, zero false positives, and a cost near OpenCV's defaults:
-
-* ``minDistanceToBorder`` 0: a marker touching the frame's edge is still read (OpenCV's default, 3 px,
-  drops it just when the drone turns towards it).
-* Two adaptive-threshold windows, 3 and 23 px (OpenCV's default adds 13): the third pass found no marker
-  the other two missed and cost a third of the time.
-* A minimum perimeter in pixels (a side of ``MIN_SIDE_PX``): smaller quads cannot carry a readable 6x6
-  cell grid, and the many tiny contours of a textured room are most of the default's cost.
-* ``polygonalApproxAccuracyRate`` 0.05 (default 0.03): a blurred or clipped marker's outline is rounder.
-* ``perspectiveRemovePixelPerCell`` 8 (default 4): each cell is read from 8x8 pixels of the unwarped marker, not
-  4x4; a cell blurred into its neighbours is read more surely (motion blur on the tuning photos' dev seeds: 85.5,
-  82.0, 76.0 -> 88.0, 88.0, 81.0 % of 200 markers; the frame's edge 83.5 -> 85.5 %; the same time per frame, no
-  false positive in 2,400 views; the ignored margin of each cell, 0.13 to 0.4, made no difference with it).
-* Sub-pixel corner refinement: the centre and the side (hence the range) to a fraction of a pixel.
-* A second look at half resolution when the full frame has no marker: motion blur halves with the image
-  and the look costs a quarter of the first.
-* A third, while the frame's budget (``vision.budget_ms``) lasts: a marker with one corner covered
-  (aruco_corner.py), which OpenCV's quadrilaterals miss; scored ``CORNER_SCORE``. A tracked marker gets that look
-  in a window where the track expects it whatever the budget (``candidates_near``).
-Every marker of the configured id is a candidate; its size must imply a plausible range.
+OpenCV's parameters were chosen on bench/vision's tuning photos for recall under motion blur and at the frame's
+edge, no false positive, and a cost near OpenCV's defaults (each choice and its figures: bench/vision/HISTORY.md,
+"The ArUco detector's parameters"). A frame without a marker gets a second look at half resolution and, while the
+frame's budget lasts, a look for a marker with one corner covered (aruco_corner.py). Every marker of the configured
+id is a candidate; its size must imply a plausible range.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-# libFuzzer target for the generated C++ StreamParser / decode / encode (tests/fuzz/fuzz_stream_parser.cpp).
+# libFuzzer target for the generated C++ StreamParser, decode, encode, parse_reply (tests/fuzz/fuzz_stream_parser.cpp).
 # Included by the top Makefile:  `make fuzz-smoke` (part of `make test`, ~35 s: the shipped spec, then in crc8
 # mode)  and  `make fuzz` (5 minutes).
 # Everything is built into build/fuzz/; the growing corpus stays in build/fuzz/corpus between runs, and a crash

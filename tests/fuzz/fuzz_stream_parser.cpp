@@ -1,4 +1,4 @@
-// libFuzzer target for the generated DroneProtocol.h: StreamParser, decode and encode.
+// libFuzzer target for the generated DroneProtocol.h: StreamParser, decode, encode and parse_reply.
 //
 // Input: a byte stream fed to a StreamParser one byte at a time. 0xFF n advances the clock by n ms (0xFF 0xFF
 // feeds 0xFF itself), so inter-byte timeouts are explored too. The same input also drives decode() on every
@@ -11,7 +11,9 @@
 //   last WIRE_LENGTH bytes fed (the frame and, with integrity crc8, its check);
 // - every emitted or decoded command lies in its command's range, matches its CommandInfo and re-encodes to
 //   the same bytes; encode() succeeds exactly for values in range, and its frame decodes back;
-// - error_name()/error_code() are total.
+// - error_name()/error_code() are total;
+// - parse_reply() of the input as a reply line: a line it accepts is exactly the line the writers write for what
+//   it read (its ready fields lie inside the input), and every line the writers write reads back as written.
 #include <DroneProtocol.h>
 
 #include <stdio.h>
@@ -210,6 +212,72 @@ void fuzz_names(const uint8_t* data, size_t size) {
   CHECK(strcmp(state_name(state), "unknown") != 0);
 }
 
+// parse_reply() of the input: what it accepts, the writers write again byte for byte (CR/LF aside).
+void fuzz_replies(const uint8_t* data, size_t size) {
+  const char* line = reinterpret_cast<const char*>(data);
+  Reply reply;
+  const ReplyError error = parse_reply(line, size, reply);
+  CHECK(strcmp(reply_error_name(error), "unknown") != 0 || error == ReplyError::Unknown);
+  if (error != ReplyError::None) return;
+  size_t length = size;
+  while (length > 0 && (line[length - 1] == '\n' || line[length - 1] == '\r')) --length;
+  char out[REPLY_MAX_LENGTH];
+  uint8_t n = 0;
+  switch (reply.kind) {
+    case ReplyKind::Ready: {
+      const char* const fields[] = {reply.protocol, reply.fingerprint, reply.integrity};
+      const size_t lengths[] = {reply.protocol_length, reply.fingerprint_length, reply.integrity_length};
+      for (uint8_t i = 0; i < 3; ++i) CHECK(fields[i] > line && fields[i] + lengths[i] <= line + length);
+      const bool own = lengths[0] == strlen(PROTOCOL_NAME) && memcmp(fields[0], PROTOCOL_NAME, lengths[0]) == 0 &&
+                       lengths[1] == strlen(SPEC_FINGERPRINT) && memcmp(fields[1], SPEC_FINGERPRINT, lengths[1]) == 0 &&
+                       lengths[2] == strlen(INTEGRITY) && memcmp(fields[2], INTEGRITY, lengths[2]) == 0;
+      if (!own) return;
+      n = write_ready(out);
+      break;
+    }
+    case ReplyKind::Accepted: {
+      const CommandInfo info = command_info(reply.command);
+      Command command{};
+      command.category = info.category;
+      command.direction = info.direction;
+      n = write_accepted(command, reply.state, reply.laser, out);
+      break;
+    }
+    case ReplyKind::Rejected:
+      n = write_rejected(reply.error, reply.state, reply.laser, out);
+      break;
+    case ReplyKind::Failsafe:
+      n = write_failsafe(reply.state, reply.laser, out);
+      break;
+  }
+  CHECK(n >= 1 && out[n - 1] == '\n' && n - 1u == length && memcmp(out, line, length) == 0);
+}
+
+// Every line the writers write reads back as written.
+void fuzz_written_replies(const uint8_t* data, size_t size) {
+  if (size < 3) return;
+  const State state = static_cast<State>(data[0] % STATE_COUNT);
+  const bool laser = (data[1] & 1) != 0;
+  const Error error = static_cast<Error>(1 + data[2] % ERROR_COUNT);
+  char out[REPLY_MAX_LENGTH];
+  Reply reply;
+  uint8_t n = write_rejected(error, state, laser, out);
+  CHECK(parse_reply(out, n, reply) == ReplyError::None && reply.kind == ReplyKind::Rejected);
+  CHECK(reply.error == error && reply.state == state && reply.laser == laser);
+  n = write_failsafe(state, laser, out);
+  CHECK(parse_reply(out, n, reply) == ReplyError::None && reply.kind == ReplyKind::Failsafe);
+  CHECK(reply.state == state && reply.laser == laser);
+  const CommandId id = static_cast<CommandId>(data[2] % COMMAND_COUNT);
+  Command command{};
+  command.category = command_info(id).category;
+  command.direction = command_info(id).direction;
+  n = write_accepted(command, state, laser, out);
+  CHECK(parse_reply(out, n, reply) == ReplyError::None && reply.kind == ReplyKind::Accepted);
+  CHECK(reply.command == id && reply.state == state && reply.laser == laser);
+  n = write_ready(out);
+  CHECK(parse_reply(out, n, reply) == ReplyError::None && reply.kind == ReplyKind::Ready);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -217,5 +285,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   fuzz_decode(data, size);
   fuzz_encode(data, size);
   fuzz_names(data, size);
+  fuzz_replies(data, size);
+  fuzz_written_replies(data, size);
   return 0;
 }

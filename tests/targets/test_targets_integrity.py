@@ -8,8 +8,11 @@ import functools
 import os
 import shutil
 import subprocess
+import sys
+from collections import Counter
 from pathlib import Path
 
+import drone_protocol as p
 import targets_harness as t
 import test_targets_differential as d
 
@@ -110,3 +113,41 @@ def _run(exe: Path, stdin: str) -> list[str]:
 def _run_cmd(cmd: list[str], stdin: str) -> list[str]:
     proc = subprocess.run(cmd, input=stdin, capture_output=True, text=True, timeout=120, check=True)
     return proc.stdout.splitlines()
+
+
+def crc8_reply_lines() -> tuple[list[bytes], int]:
+    """Every reply line a crc8 drone writes (ready, accepted per command, rejected per error, failsafe per state)
+    and a few malformed ones, each also with a wrong check, without its check, with a lower-case check and with
+    the check of another line; and how many of them carry their right check."""
+    states = list(p.DroneState)
+    bodies = [p.ready_line().rstrip(b"\n").replace(b" none", b" crc8")]
+    commands = [p.decode(p.encode(s.category, s.direction, s.minimum)) for s in p.COMMANDS.values()]
+    bodies += [p.accepted_line(c, states[i % len(states)], i % 2 == 1).rstrip(b"\n") for i, c in enumerate(commands)]
+    bodies += [p.rejected_line(k, states[i % len(states)], False).rstrip(b"\n") for i, k in enumerate(p.ErrorKind)]
+    bodies += [p.failsafe_line(s, True).rstrip(b"\n") for s in states] + [b"A?? d0", b"Ez d0", b"#READY", b"hello"]
+    lines, good = [], 0
+    for body in bodies:
+        check = check_text(body)
+        for tail in (check, f"{(int(check, 16) + 1) % 256:02X}", check.lower(), check_text(body + b"!")):
+            lines.append(body + b"*" + tail.encode() + b"\n")
+            good += tail == check
+        lines.append(body + b"\r\n")
+    return lines, good
+
+
+def test_the_crc8_cpp_reply_parser_reads_lines_as_c_and_python_do() -> None:
+    tree, (lines, good) = crc8_tree(), crc8_reply_lines()
+    stdin = "".join(line.hex() + "\n" for line in lines)
+    c, cpp = BUILD / "reply_driver_c", BUILD / "reply_driver_cpp"
+    t.run(["gcc", *t.CFLAGS, f"-I{tree / 'c'}", str(t.DRIVERS / "reply_driver.c"), str(tree / "c" / "drone_protocol.c"),
+           "-o", str(c)])
+    t.run(["g++", *t.CXXFLAGS, f"-I{tree / 'arduino' / 'DroneProtocol' / 'src'}", str(t.DRIVERS / "reply_driver.cpp"),
+           "-o", str(cpp)])
+    python = subprocess.run([sys.executable, str(t.DRIVERS / "reply_driver.py")], input=stdin, capture_output=True,
+                            text=True, timeout=120, check=True, env={**os.environ, "PYTHONPATH": str(tree / "python")})
+    got = _run(cpp, stdin)
+    assert got == _run(c, stdin) == python.stdout.splitlines()
+    counts = Counter(r.split()[0] for r in got)
+    assert counts["bad_check"] == len(lines) - good and good > 0, counts
+    firsts = [r.split()[0] for r in got[::5]]  # each body with its right check: the drone's own lines pass
+    assert firsts[:-4] == ["ready"] + ["ok"] * (len(firsts) - 5) and "ok" not in firsts[-4:], firsts

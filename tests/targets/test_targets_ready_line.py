@@ -1,7 +1,7 @@
 """The ready line's one rule (spec replies.ready), the same in every language: the shared vectors of
 vectors.json, and every combination of odd gaps around the prefix and the fields, through each language's reply
-driver (drivers/reply_driver.*), which must give identical answers. The C++ library writes the line only: its
-line must be the one the rule reads."""
+driver (drivers/reply_driver.*), which must give identical answers; the C++ library's own line must be the one
+the rule reads."""
 
 from __future__ import annotations
 
@@ -24,9 +24,11 @@ def reply_drivers() -> dict[str, list[str]]:
     c = t.BUILD / "reply_driver_c"
     t.BUILD.mkdir(parents=True, exist_ok=True)
     t.run(["gcc", *t.CFLAGS, f"-I{t.C_DIR}", str(t.DRIVERS / "reply_driver.c"), *map(str, t.c_sources()), "-o", str(c)])
+    cpp = t.BUILD / "reply_driver_cpp"
+    t.run(["g++", *t.CXXFLAGS, f"-I{t.CPP_DIR}", str(t.DRIVERS / "reply_driver.cpp"), "-o", str(cpp)])
     dist = t.ROOT / "build" / "typescript" / "package" / "dist"
     t.typescript_driver()  # builds the package
-    return {"python": [sys.executable, str(t.DRIVERS / "reply_driver.py")], "c": [str(c)],
+    return {"python": [sys.executable, str(t.DRIVERS / "reply_driver.py")], "c": [str(c)], "cpp": [str(cpp)],
             "rust": [str(t.rustc_program(t.DRIVERS / "reply_driver.rs", "reply_driver_rs"))],
             "typescript": ["node", str(t.TYPESCRIPT_DRIVER.parent / "reply_driver.mjs"), str(dist)]}
 

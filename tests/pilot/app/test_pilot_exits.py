@@ -139,44 +139,44 @@ def wait_until(cond: Callable[[], bool], proc: subprocess.Popen[bytes], timeout:
         time.sleep(0.02)
 
 
-def test_cli_signal_with_laser_on_lands_and_prints_what_the_drone_confirmed(tmp_path: Path) -> None:
+def signalled(tmp_path: Path, act: Callable[[PtyDrone, subprocess.Popen[bytes]], None]) -> tuple[PtyDrone, str, str]:
+    """The pilot against the fake drone until its laser is on, then ``act``; its exit status 130 checked, and what
+    it printed."""
     drone = PtyDrone()
     proc = start(tmp_path, drone)
     try:
         wait_until(lambda: drone.drone.laser, proc)
-        proc.send_signal(signal.SIGTERM)
+        act(drone, proc)
         out, err = proc.communicate(timeout=30)
     finally:
         if proc.poll() is None:
             proc.kill()
         drone.close()
     assert proc.returncode == 130, err.decode()
+    return drone, out.decode(), err.decode()
+
+
+def test_cli_signal_with_laser_on_lands_and_prints_what_the_drone_confirmed(tmp_path: Path) -> None:
+    drone, out, _ = signalled(tmp_path, lambda _, proc: proc.send_signal(signal.SIGTERM))
     sent = drone.frames()
     assert sent[0] == "arm" and "laser_toggle" not in sent and "move_down" not in sent
     after = sent[len(sent) - sent[::-1].index("laser_on") :]
     assert after[0] == "laser_off" and "land" in after
     assert set(after) <= {"laser_off", "servo_reset", "land", "hold_altitude", "query_status"}
     assert drone.drone.state is dp.DroneState.DISARMED and not drone.drone.laser
-    assert "the drone confirmed: disarmed (not armed), laser off" in out.decode()
+    assert "the drone confirmed: disarmed (not armed), laser off" in out
 
 
 def test_cli_second_signal_while_landing(tmp_path: Path) -> None:
-    drone = PtyDrone()
-    proc = start(tmp_path, drone)
-    try:
-        wait_until(lambda: drone.drone.laser, proc)
+    def twice(drone: PtyDrone, proc: subprocess.Popen[bytes]) -> None:
         proc.send_signal(signal.SIGINT)
         wait_until(lambda: drone.drone.state is dp.DroneState.LANDING, proc)
         proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-        drone.close()
-    assert proc.returncode == 130, err.decode()
-    assert "interrupted again while landing" in err.decode()
+
+    drone, out, err = signalled(tmp_path, twice)
+    assert "interrupted again while landing" in err
     assert drone.drone.state is dp.DroneState.DISARMED and not drone.drone.laser
-    assert "the drone confirmed: disarmed (not armed), laser off" in out.decode()
+    assert "the drone confirmed: disarmed (not armed), laser off" in out
 
 
 def test_cli_vanished_port_one_line_no_traceback(tmp_path: Path) -> None:

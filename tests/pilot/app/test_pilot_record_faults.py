@@ -80,6 +80,17 @@ def test_the_links_log_is_bounded_and_a_failing_subscriber_is_dropped(capfd: pyt
     assert err.count("\n") == 1 and "log subscriber failed" in err and "the link goes on" in err
 
 
+def test_the_summary_names_the_files_of_a_recording_or_says_why_it_ended(tmp_path: Path) -> None:
+    video, log, picture = tmp_path / "flight.avi", tmp_path / "log.jsonl", str(tmp_path / "path.png")
+    assert record.summary_lines(tmp_path, "", simulated=True, picture=picture) == [
+        f"recording: {video}", f"log:       {log}", f"path:      {picture}"]
+    assert record.summary_lines(tmp_path, "", simulated=False) == [f"recording: {video}", f"log:       {log}"]
+    stopped = f"recording: stopped early ({log}: No space left on device); {video} and {log} end there"
+    assert record.summary_lines(tmp_path, f"{log}: No space left on device", simulated=True) == [
+        stopped, "path:      not drawn: the recording had stopped"]
+    assert record.summary_lines(tmp_path, f"{log}: No space left on device", simulated=False) == [stopped]
+
+
 def _full_after(writes: int) -> object:
     def opener(path: Path) -> IO[str]:
         return FullDisk(writes)
@@ -101,6 +112,11 @@ def test_a_disk_full_mid_flight_still_lands_disarms_and_prints_the_summary(
     assert err.count("pilot: recording stopped:") == 1, err
     assert "drone:     laser off, disarmed, altitude 0.00 m" in out, out + err
     assert out.startswith("ahead      seed   2 hsv "), out  # the flight's summary
+    # what the recording holds, in words: never "path: None"
+    rec = tmp_path / "rec"
+    assert (f"recording: stopped early ({rec / 'log.jsonl'}: No space left on device); {rec / 'flight.avi'} and "
+            f"{rec / 'log.jsonl'} end there\npath:      not drawn: the recording had stopped\n") in out, out
+    assert "None" not in out, out
     if policy == "stop":  # landed early: the flight did not do its job
         assert code == 1 and "landing (record_failure: stop)" in err and "stopped by RecordingFailed" in err
     else:

@@ -10,6 +10,8 @@
 //   DroneProtocol_codec.h     decode(), encode() and the byte-at-a-time StreamParser
 //   DroneProtocol_dispatch.h  dispatch() of a decoded command to the sketch's handlers
 //   DroneProtocol_replies.h   the reply lines (Arduino -> Pi)
+//   DroneProtocol_api.h       lookups by name and by code bytes, defaults, one encoder per command
+//   DroneProtocol_reply_parser.h  parse_reply() of a reply line, for the Pi's side (host tools)
 //
 // Use: feed every received byte to a StreamParser; when feed() returns true, dispatch() its command(), then
 // reply with what the handler decided:
@@ -29,5 +31,6 @@
 #include "DroneProtocol_dispatch.h"
 #include "DroneProtocol_replies.h"
 #include "DroneProtocol_api.h"
+#include "DroneProtocol_reply_parser.h"
 
 #endif  // DRONE_PROTOCOL_H
