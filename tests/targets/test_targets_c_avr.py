@@ -1,11 +1,13 @@
 """The C99 codec on the ATmega328P (avr-gcc -Os), for the shipped spec and its crc8 variant: a program that encodes
 and decodes one frame holds at most 64 B of static RAM (the tables and names live in flash) and, run in simavr,
 sends the frame and what it decoded; a tour of the whole API (tests/targets/avr/api_tour.c) prints in simavr what
-its host build prints, names read from flash through the _P functions included."""
+its host build prints, names read from flash through the _P functions included; the AVR example of the C
+codec's README runs in simavr within the same budget."""
 
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 from pathlib import Path
 
@@ -83,3 +85,16 @@ def test_the_api_in_simavr_says_what_it_says_on_the_host(spec: str, tmp_path: Pa
     assert sum(line.startswith("found ") for line in lines) == len(commands)
     elf = avr_build(tree, "api_tour.c", tmp_path / "api_tour.elf", *GC_SECTIONS)
     assert simulated_output(elf, 150) == expected
+
+
+def test_the_readmes_avr_example_runs_in_simavr_within_the_budget(tmp_path: Path) -> None:
+    (code,) = re.findall(r"^```c avr\n(.*?)^```$", (t.C_DIR / "README.md").read_text(encoding="utf-8"), re.M | re.S)
+    source = tmp_path / "example.c"
+    includes = "".join(f"#include {h}\n" for h in ("<assert.h>", "<string.h>", "<avr/pgmspace.h>", '"drone_protocol.h"',
+                                                    '"out.h"'))
+    source.write_text(includes + "int main(void) {\n  out_init();\n  {\n" + code + '  }\n  out_text("ok\\n");\n'
+                      "  for (;;) {\n  }\n}\n", encoding="utf-8")
+    elf = tmp_path / "example.elf"
+    t.run([*AVR_GCC, f"-I{t.C_DIR}", *GC_SECTIONS, str(source), str(t.C_DIR / "drone_protocol.c"), "-o", str(elf)])
+    assert static_ram(elf) <= RAM_BUDGET
+    assert simulated_output(elf, 5) == "ok\n"  # a failed assert() aborts before
