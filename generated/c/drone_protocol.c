@@ -8,10 +8,6 @@
 
 #ifdef __AVR__
 #include <avr/pgmspace.h>
-#if defined(__GNUC__) && !defined(__clang__)
-/* gcc turns a switch that returns constants into a lookup table, which avr-gcc keeps in RAM. */
-#pragma GCC optimize("no-tree-switch-conversion")
-#endif
 #define IN_FLASH PROGMEM
 #define flash_byte(p) pgm_read_byte(p)
 #define flash_word(p) pgm_read_word(p)
@@ -125,108 +121,65 @@ static const char *const REPLY_PREFIXES[4] IN_FLASH = {
 };
 
 #define REPLY_COUNT (sizeof REPLY_PREFIXES / sizeof REPLY_PREFIXES[0])
-static const char STATE_NAME_0[] IN_FLASH = "disarmed";
-static const char STATE_NAME_1[] IN_FLASH = "arming";
-static const char STATE_NAME_2[] IN_FLASH = "armed";
-static const char STATE_NAME_3[] IN_FLASH = "hold_altitude";
-static const char STATE_NAME_4[] IN_FLASH = "moving";
-static const char STATE_NAME_5[] IN_FLASH = "landing";
-static const char STATE_NAME_6[] IN_FLASH = "disarming";
-static const char STATE_NAME_7[] IN_FLASH = "self_test";
-static const char STATE_NAME_8[] IN_FLASH = "failsafe";
+/* The states' codes in spec order, and those of the armed states: tables, not switches (which avr-gcc would turn
+   into tables in RAM). */
+static const char STATE_CODES[] IN_FLASH = "drahmlktf";
+static const char ARMED_STATE_CODES[] IN_FLASH = "ahmlk";
+static const char STATE_NAMES_0[] IN_FLASH = "disarmed";
+static const char STATE_NAMES_1[] IN_FLASH = "arming";
+static const char STATE_NAMES_2[] IN_FLASH = "armed";
+static const char STATE_NAMES_3[] IN_FLASH = "hold_altitude";
+static const char STATE_NAMES_4[] IN_FLASH = "moving";
+static const char STATE_NAMES_5[] IN_FLASH = "landing";
+static const char STATE_NAMES_6[] IN_FLASH = "disarming";
+static const char STATE_NAMES_7[] IN_FLASH = "self_test";
+static const char STATE_NAMES_8[] IN_FLASH = "failsafe";
+static const char *const STATE_NAMES[9] IN_FLASH = {
+    STATE_NAMES_0,
+    STATE_NAMES_1,
+    STATE_NAMES_2,
+    STATE_NAMES_3,
+    STATE_NAMES_4,
+    STATE_NAMES_5,
+    STATE_NAMES_6,
+    STATE_NAMES_7,
+    STATE_NAMES_8,
+};
+
 static const char UNKNOWN[] IN_FLASH = "unknown";
 static const char EMPTY[] IN_FLASH = "";
 #ifdef __AVR__
+/* A first byte's category in constant time: CATEGORY_LOOKUP[byte - CATEGORY_FIRST] is its index + 1 (0: none).
+   Per category, DIRECTION_LOOKUP from DIRECTION_OFFSET maps a second byte from DIRECTION_FIRST over DIRECTION_SPAN
+   bytes to the command's index + 1 (0: none). */
+#define CATEGORY_FIRST 105u
+static const uint8_t CATEGORY_LOOKUP[12] IN_FLASH = {5, 0, 0, 4, 1, 0, 0, 0, 0, 0, 3, 2};
+static const uint8_t DIRECTION_FIRST[5] IN_FLASH = {98, 108, 100, 48, 97};
+static const uint8_t DIRECTION_SPAN[5] IN_FLASH = {20, 7, 21, 63, 20};
+static const uint16_t DIRECTION_OFFSET[5] IN_FLASH = {0, 20, 27, 48, 111};
+static const uint16_t DIRECTION_LOOKUP[131] IN_FLASH = {
+2, 0, 6, 0, 1, 0, 0, 0, 0, 0, 3, 0, 0, 0, 0, 0, 4, 0, 0, 5, /* move */
+7, 0, 0, 0, 0, 0, 8, /* turn */
+10, 0, 0, 0, 0, 0, 0, 0, 11, 0, 0, 0, 0, 0, 12, 0, 0, 9, 0, 0, 13, /* servo */
+14, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 16, 0, 0, 0, 0, 0, 0, 0, 15, /* laser */
+17, 0, 0, 0, 0, 0, 0, 0, 0, 0, 18, 21, 0, 0, 0, 0, 22, 0, 19, 20, /* init */
+};
 
-/* Is this byte a category? */
-bool dp_is_category(uint8_t byte) {
-  switch (byte) {
-    case 'm':
-    case 't':
-    case 's':
-    case 'l':
-    case 'i':
-      return true;
-    default:
-      return false;
-  }
+/* The category index + 1 of a first byte, or 0. */
+static uint8_t category_of(uint8_t byte) {
+  const uint8_t at = (uint8_t)(byte - CATEGORY_FIRST);
+  return at < sizeof CATEGORY_LOOKUP ? flash_byte(&CATEGORY_LOOKUP[at]) : 0;
 }
 
-/* The command whose frame starts with these two bytes, or -1. */
+bool dp_is_category(uint8_t byte) { return category_of(byte) != 0; }
+
 int dp_find_command(uint8_t category, uint8_t direction) {
-  switch (category) {
-    case 'm':
-      switch (direction) {
-        case 'f':
-          return DP_CMD_MOVE_FORWARD;
-        case 'b':
-          return DP_CMD_MOVE_BACKWARD;
-        case 'l':
-          return DP_CMD_MOVE_LEFT;
-        case 'r':
-          return DP_CMD_MOVE_RIGHT;
-        case 'u':
-          return DP_CMD_MOVE_UP;
-        case 'd':
-          return DP_CMD_MOVE_DOWN;
-        default:
-          return -1;
-      }
-    case 't':
-      switch (direction) {
-        case 'l':
-          return DP_CMD_TURN_LEFT;
-        case 'r':
-          return DP_CMD_TURN_RIGHT;
-        default:
-          return -1;
-      }
-    case 's':
-      switch (direction) {
-        case 'u':
-          return DP_CMD_SERVO_UP;
-        case 'd':
-          return DP_CMD_SERVO_DOWN;
-        case 'l':
-          return DP_CMD_SERVO_LEFT;
-        case 'r':
-          return DP_CMD_SERVO_RIGHT;
-        case 'x':
-          return DP_CMD_SERVO_RESET;
-        default:
-          return -1;
-      }
-    case 'l':
-      switch (direction) {
-        case '0':
-          return DP_CMD_LASER_TOGGLE;
-        case 'n':
-          return DP_CMD_LASER_ON;
-        case 'f':
-          return DP_CMD_LASER_OFF;
-        default:
-          return -1;
-      }
-    case 'i':
-      switch (direction) {
-        case 'a':
-          return DP_CMD_ARM;
-        case 'k':
-          return DP_CMD_DISARM;
-        case 's':
-          return DP_CMD_HOLD_ALTITUDE;
-        case 't':
-          return DP_CMD_FIRST_TEST;
-        case 'l':
-          return DP_CMD_LAND;
-        case 'q':
-          return DP_CMD_QUERY_STATUS;
-        default:
-          return -1;
-      }
-    default:
-      return -1;
-  }
+  const uint8_t c = category_of(category);
+  uint8_t at;
+  if (c == 0) return -1;
+  at = (uint8_t)(direction - flash_byte(&DIRECTION_FIRST[c - 1]));
+  if (at >= flash_byte(&DIRECTION_SPAN[c - 1])) return -1;
+  return (int)flash_word(&DIRECTION_LOOKUP[flash_word(&DIRECTION_OFFSET[c - 1]) + at]) - 1;
 }
 #else
 const dp_command_info *dp_command_info_of(dp_command_id id) {
@@ -452,59 +405,19 @@ const dp_state dp_states[DP_STATE_COUNT] = {
 DP_STATE_DISARMED, DP_STATE_ARMING, DP_STATE_ARMED, DP_STATE_HOLD_ALTITUDE, DP_STATE_MOVING, DP_STATE_LANDING, DP_STATE_DISARMING, DP_STATE_SELF_TEST, DP_STATE_FAILSAFE
 };
 
-bool dp_state_armed(dp_state state) {
-  switch (state) {
-    case DP_STATE_ARMED:
-    case DP_STATE_HOLD_ALTITUDE:
-    case DP_STATE_MOVING:
-    case DP_STATE_LANDING:
-    case DP_STATE_DISARMING:
-      return true;
-    default:
-      return false;
-  }
+/* Is `code` one of the characters of `codes` (a string in flash on AVR)? */
+static bool code_in(int code, const char *codes) {
+  return code > 0 && code <= 255 && flash_strchr(codes, code) != NULL;
 }
+
+bool dp_state_armed(dp_state state) { return code_in((int)state, ARMED_STATE_CODES); }
 
 const char *NAME_FUNCTION(dp_state_name)(dp_state state) {
-  switch (state) {
-    case DP_STATE_DISARMED:
-      return STATE_NAME_0;
-    case DP_STATE_ARMING:
-      return STATE_NAME_1;
-    case DP_STATE_ARMED:
-      return STATE_NAME_2;
-    case DP_STATE_HOLD_ALTITUDE:
-      return STATE_NAME_3;
-    case DP_STATE_MOVING:
-      return STATE_NAME_4;
-    case DP_STATE_LANDING:
-      return STATE_NAME_5;
-    case DP_STATE_DISARMING:
-      return STATE_NAME_6;
-    case DP_STATE_SELF_TEST:
-      return STATE_NAME_7;
-    case DP_STATE_FAILSAFE:
-      return STATE_NAME_8;
-  }
-  return UNKNOWN;
+  if (!code_in((int)state, STATE_CODES)) return UNKNOWN;
+  return flash_string(&STATE_NAMES[flash_strchr(STATE_CODES, (int)state) - STATE_CODES]);
 }
 
-bool dp_is_state(uint8_t code) {
-  switch (code) {
-    case 'd':
-    case 'r':
-    case 'a':
-    case 'h':
-    case 'm':
-    case 'l':
-    case 'k':
-    case 't':
-    case 'f':
-      return true;
-    default:
-      return false;
-  }
-}
+bool dp_is_state(uint8_t code) { return code_in(code, STATE_CODES); }
 
 /* The ready line's one rule (the spec's replies.ready): after the prefix, exactly one space before each field;
    the protocol, the fingerprint's hex digits and a known integrity mode; nothing else. */

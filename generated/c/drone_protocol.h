@@ -292,8 +292,10 @@ int dp_find_command_by_name(const char *name);
 bool dp_command_default(dp_command_id id, uint16_t *value);
 
 #ifdef __AVR__
-/* Functions in the .c on AVR, where gcc would turn these switches into lookup tables in RAM. */
+/* Is this byte a category? */
 bool dp_is_category(uint8_t byte);
+/* The command whose frame starts with these two bytes, or -1. In the .c on AVR, as reads of flash tables: gcc
+   would turn the switches below into lookup tables in RAM. */
 int dp_find_command(uint8_t category, uint8_t direction);
 #else
 /* Is this byte a category? */
@@ -386,7 +388,6 @@ static inline int dp_find_command(uint8_t category, uint8_t direction) {
       return -1;
   }
 }
-
 #endif
 
 /* CRC-8/SMBUS (polynomial 0x07, initial value 0, no reflection): the check of the crc8 integrity mode. */
@@ -509,25 +510,10 @@ const char *dp_state_name(dp_state state);
 #else
 const char *dp_state_name_P(dp_state state); /* in flash, as dp_command_name_P() */
 static inline const char *dp_state_name(dp_state state) {
-  switch (state) {
-    case DP_STATE_DISARMED:
-      return "disarmed";
-    case DP_STATE_ARMING:
-      return "arming";
-    case DP_STATE_ARMED:
-      return "armed";
-    case DP_STATE_HOLD_ALTITUDE:
-      return "hold_altitude";
-    case DP_STATE_MOVING:
-      return "moving";
-    case DP_STATE_LANDING:
-      return "landing";
-    case DP_STATE_DISARMING:
-      return "disarming";
-    case DP_STATE_SELF_TEST:
-      return "self_test";
-    case DP_STATE_FAILSAFE:
-      return "failsafe";
+  static const char *const names[DP_STATE_COUNT] = {"disarmed", "arming", "armed", "hold_altitude", "moving", "landing", "disarming", "self_test", "failsafe"};
+  int i;
+  for (i = 0; i < DP_STATE_COUNT; ++i) {
+    if (dp_states[i] == state) return names[i];
   }
   return "unknown";
 }
