@@ -26,6 +26,7 @@ TARGETS: tuple[Target, ...] = (
     Target("contract", ""),  # what a peer relies on: the previous version for the breaking-change check
     Target("ardupilot", "ardupilot"),
     Target("rust", "rust", own_header=True),  # each template prints the header in its file's own syntax
+    Target("vectors", "rust/tests"),  # the crate's own copy: its packaged tests run without the repository
     Target("c", "c"),
     Target("typescript", "typescript", own_header=True),  # .ts, .mjs, .json, .html: each template prints its header
 )

@@ -6,70 +6,203 @@
 
 #include <string.h>
 
-static const dp_command_info COMMANDS[DP_COMMAND_COUNT] = {
-    {"move_forward", 'm', 'f', 1000, 2000, 1600, true, DP_TARGET_PITCH, 0},
-    {"move_backward", 'm', 'b', 1000, 2000, 1400, true, DP_TARGET_PITCH, 0},
-    {"move_left", 'm', 'l', 1000, 2000, 1400, true, DP_TARGET_ROLL, 0},
-    {"move_right", 'm', 'r', 1000, 2000, 1600, true, DP_TARGET_ROLL, 0},
-    {"move_up", 'm', 'u', 1029, 2012, 1621, true, DP_TARGET_THROTTLE, 0},
-    {"move_down", 'm', 'd', 1029, 2012, 1421, true, DP_TARGET_THROTTLE, 0},
-    {"turn_left", 't', 'l', 1035, 2012, 1424, true, DP_TARGET_YAW, 0},
-    {"turn_right", 't', 'r', 1035, 2012, 1624, true, DP_TARGET_YAW, 0},
-    {"servo_up", 's', 'u', 1, 180, 0, false, DP_TARGET_TILT, 1},
-    {"servo_down", 's', 'd', 1, 180, 0, false, DP_TARGET_TILT, -1},
-    {"servo_left", 's', 'l', 1, 180, 0, false, DP_TARGET_PAN, -1},
-    {"servo_right", 's', 'r', 1, 180, 0, false, DP_TARGET_PAN, 1},
-    {"servo_reset", 's', 'x', 0, 0, 0, true, DP_TARGET_BOTH, 0},
-    {"laser_toggle", 'l', '0', 0, 0, 0, true, DP_TARGET_NONE, 0},
-    {"laser_on", 'l', 'n', 0, 0, 0, true, DP_TARGET_NONE, 0},
-    {"laser_off", 'l', 'f', 0, 1, 1, true, DP_TARGET_NONE, 0},
-    {"arm", 'i', 'a', 0, 0, 0, true, DP_TARGET_NONE, 0},
-    {"disarm", 'i', 'k', 0, 0, 0, true, DP_TARGET_NONE, 0},
-    {"hold_altitude", 'i', 's', 0, 1, 1, true, DP_TARGET_NONE, 0},
-    {"first_test", 'i', 't', 0, 0, 0, true, DP_TARGET_NONE, 0},
-    {"land", 'i', 'l', 0, 0, 0, true, DP_TARGET_NONE, 0},
-    {"query_status", 'i', 'q', 2, 2, 2, true, DP_TARGET_NONE, 0},
+#ifdef __AVR__
+#include <avr/pgmspace.h>
+#define IN_FLASH PROGMEM
+#define flash_byte(p) pgm_read_byte(p)
+#define flash_word(p) pgm_read_word(p)
+#define flash_string(p) ((const char *)pgm_read_word(p)) /* a string's address, stored in flash */
+#define flash_strlen strlen_P
+#define flash_strcmp strcmp_P /* (RAM, flash) */
+#define flash_memcmp memcmp_P /* (RAM, flash, n) */
+#define flash_strchr strchr_P
+#define NAME_FUNCTION(name) name##_P /* the functions below that return a name in flash */
+#else
+#define IN_FLASH
+#define flash_byte(p) (*(p))
+#define flash_word(p) (*(p))
+#define flash_string(p) (*(p))
+#define flash_strlen strlen
+#define flash_strcmp strcmp
+#define flash_memcmp memcmp
+#define flash_strchr strchr
+#define NAME_FUNCTION(name) name
+#endif
+
+static const char COMMAND_NAME_0[] IN_FLASH = "move_forward";
+static const char COMMAND_NAME_1[] IN_FLASH = "move_backward";
+static const char COMMAND_NAME_2[] IN_FLASH = "move_left";
+static const char COMMAND_NAME_3[] IN_FLASH = "move_right";
+static const char COMMAND_NAME_4[] IN_FLASH = "move_up";
+static const char COMMAND_NAME_5[] IN_FLASH = "move_down";
+static const char COMMAND_NAME_6[] IN_FLASH = "turn_left";
+static const char COMMAND_NAME_7[] IN_FLASH = "turn_right";
+static const char COMMAND_NAME_8[] IN_FLASH = "servo_up";
+static const char COMMAND_NAME_9[] IN_FLASH = "servo_down";
+static const char COMMAND_NAME_10[] IN_FLASH = "servo_left";
+static const char COMMAND_NAME_11[] IN_FLASH = "servo_right";
+static const char COMMAND_NAME_12[] IN_FLASH = "servo_reset";
+static const char COMMAND_NAME_13[] IN_FLASH = "laser_toggle";
+static const char COMMAND_NAME_14[] IN_FLASH = "laser_on";
+static const char COMMAND_NAME_15[] IN_FLASH = "laser_off";
+static const char COMMAND_NAME_16[] IN_FLASH = "arm";
+static const char COMMAND_NAME_17[] IN_FLASH = "disarm";
+static const char COMMAND_NAME_18[] IN_FLASH = "hold_altitude";
+static const char COMMAND_NAME_19[] IN_FLASH = "first_test";
+static const char COMMAND_NAME_20[] IN_FLASH = "land";
+static const char COMMAND_NAME_21[] IN_FLASH = "query_status";
+static const dp_command_info COMMANDS[DP_COMMAND_COUNT] IN_FLASH = {
+    {COMMAND_NAME_0, 'm', 'f', 1000, 2000, 1600, true, DP_TARGET_PITCH, 0},
+    {COMMAND_NAME_1, 'm', 'b', 1000, 2000, 1400, true, DP_TARGET_PITCH, 0},
+    {COMMAND_NAME_2, 'm', 'l', 1000, 2000, 1400, true, DP_TARGET_ROLL, 0},
+    {COMMAND_NAME_3, 'm', 'r', 1000, 2000, 1600, true, DP_TARGET_ROLL, 0},
+    {COMMAND_NAME_4, 'm', 'u', 1029, 2012, 1621, true, DP_TARGET_THROTTLE, 0},
+    {COMMAND_NAME_5, 'm', 'd', 1029, 2012, 1421, true, DP_TARGET_THROTTLE, 0},
+    {COMMAND_NAME_6, 't', 'l', 1035, 2012, 1424, true, DP_TARGET_YAW, 0},
+    {COMMAND_NAME_7, 't', 'r', 1035, 2012, 1624, true, DP_TARGET_YAW, 0},
+    {COMMAND_NAME_8, 's', 'u', 1, 180, 0, false, DP_TARGET_TILT, 1},
+    {COMMAND_NAME_9, 's', 'd', 1, 180, 0, false, DP_TARGET_TILT, -1},
+    {COMMAND_NAME_10, 's', 'l', 1, 180, 0, false, DP_TARGET_PAN, -1},
+    {COMMAND_NAME_11, 's', 'r', 1, 180, 0, false, DP_TARGET_PAN, 1},
+    {COMMAND_NAME_12, 's', 'x', 0, 0, 0, true, DP_TARGET_BOTH, 0},
+    {COMMAND_NAME_13, 'l', '0', 0, 0, 0, true, DP_TARGET_NONE, 0},
+    {COMMAND_NAME_14, 'l', 'n', 0, 0, 0, true, DP_TARGET_NONE, 0},
+    {COMMAND_NAME_15, 'l', 'f', 0, 1, 1, true, DP_TARGET_NONE, 0},
+    {COMMAND_NAME_16, 'i', 'a', 0, 0, 0, true, DP_TARGET_NONE, 0},
+    {COMMAND_NAME_17, 'i', 'k', 0, 0, 0, true, DP_TARGET_NONE, 0},
+    {COMMAND_NAME_18, 'i', 's', 0, 1, 1, true, DP_TARGET_NONE, 0},
+    {COMMAND_NAME_19, 'i', 't', 0, 0, 0, true, DP_TARGET_NONE, 0},
+    {COMMAND_NAME_20, 'i', 'l', 0, 0, 0, true, DP_TARGET_NONE, 0},
+    {COMMAND_NAME_21, 'i', 'q', 2, 2, 2, true, DP_TARGET_NONE, 0},
 };
 
 /* Reply code letters indexed by error. */
-static const char ERROR_CODES[DP_ERROR_COUNT + 1] = {'?', 'c', 'd', 'g', 'r', 't', 's', 'l', 'n', 'b', 'u', 'a', 'i', 'x'};
-static const char *const ERROR_NAMES[DP_ERROR_COUNT + 1] = {
-    "none",
-    "bad_category",
-    "bad_direction",
-    "bad_digit",
-    "out_of_range",
-    "timeout",
-    "too_short",
-    "too_long",
-    "not_armed",
-    "busy",
-    "unsupported",
-    "armed",
-    "airborne",
-    "bad_check",
+static const char ERROR_CODES[DP_ERROR_COUNT + 1] IN_FLASH = {'?', 'c', 'd', 'g', 'r', 't', 's', 'l', 'n', 'b', 'u', 'a', 'i', 'x'};
+static const char ERROR_NAMES_0[] IN_FLASH = "none";
+static const char ERROR_NAMES_1[] IN_FLASH = "bad_category";
+static const char ERROR_NAMES_2[] IN_FLASH = "bad_direction";
+static const char ERROR_NAMES_3[] IN_FLASH = "bad_digit";
+static const char ERROR_NAMES_4[] IN_FLASH = "out_of_range";
+static const char ERROR_NAMES_5[] IN_FLASH = "timeout";
+static const char ERROR_NAMES_6[] IN_FLASH = "too_short";
+static const char ERROR_NAMES_7[] IN_FLASH = "too_long";
+static const char ERROR_NAMES_8[] IN_FLASH = "not_armed";
+static const char ERROR_NAMES_9[] IN_FLASH = "busy";
+static const char ERROR_NAMES_10[] IN_FLASH = "unsupported";
+static const char ERROR_NAMES_11[] IN_FLASH = "armed";
+static const char ERROR_NAMES_12[] IN_FLASH = "airborne";
+static const char ERROR_NAMES_13[] IN_FLASH = "bad_check";
+static const char *const ERROR_NAMES[14] IN_FLASH = {
+    ERROR_NAMES_0,
+    ERROR_NAMES_1,
+    ERROR_NAMES_2,
+    ERROR_NAMES_3,
+    ERROR_NAMES_4,
+    ERROR_NAMES_5,
+    ERROR_NAMES_6,
+    ERROR_NAMES_7,
+    ERROR_NAMES_8,
+    ERROR_NAMES_9,
+    ERROR_NAMES_10,
+    ERROR_NAMES_11,
+    ERROR_NAMES_12,
+    ERROR_NAMES_13,
 };
 
+static const char REPLY_PREFIXES_0[] IN_FLASH = "#READY";
+static const char REPLY_PREFIXES_1[] IN_FLASH = "A";
+static const char REPLY_PREFIXES_2[] IN_FLASH = "E";
+static const char REPLY_PREFIXES_3[] IN_FLASH = "!F";
+static const char *const REPLY_PREFIXES[4] IN_FLASH = {
+    REPLY_PREFIXES_0,
+    REPLY_PREFIXES_1,
+    REPLY_PREFIXES_2,
+    REPLY_PREFIXES_3,
+};
+
+#define REPLY_COUNT (sizeof REPLY_PREFIXES / sizeof REPLY_PREFIXES[0])
+/* The states' codes in spec order, and those of the armed states: tables, not switches (which avr-gcc would turn
+   into tables in RAM). */
+static const char STATE_CODES[] IN_FLASH = "drahmlktf";
+static const char ARMED_STATE_CODES[] IN_FLASH = "ahmlk";
+static const char STATE_NAMES_0[] IN_FLASH = "disarmed";
+static const char STATE_NAMES_1[] IN_FLASH = "arming";
+static const char STATE_NAMES_2[] IN_FLASH = "armed";
+static const char STATE_NAMES_3[] IN_FLASH = "hold_altitude";
+static const char STATE_NAMES_4[] IN_FLASH = "moving";
+static const char STATE_NAMES_5[] IN_FLASH = "landing";
+static const char STATE_NAMES_6[] IN_FLASH = "disarming";
+static const char STATE_NAMES_7[] IN_FLASH = "self_test";
+static const char STATE_NAMES_8[] IN_FLASH = "failsafe";
+static const char *const STATE_NAMES[9] IN_FLASH = {
+    STATE_NAMES_0,
+    STATE_NAMES_1,
+    STATE_NAMES_2,
+    STATE_NAMES_3,
+    STATE_NAMES_4,
+    STATE_NAMES_5,
+    STATE_NAMES_6,
+    STATE_NAMES_7,
+    STATE_NAMES_8,
+};
+
+static const char UNKNOWN[] IN_FLASH = "unknown";
+static const char EMPTY[] IN_FLASH = "";
+#ifdef __AVR__
+/* A first byte's category in constant time: CATEGORY_LOOKUP[byte - CATEGORY_FIRST] is its index + 1 (0: none).
+   Per category, DIRECTION_LOOKUP from DIRECTION_OFFSET maps a second byte from DIRECTION_FIRST over DIRECTION_SPAN
+   bytes to the command's index + 1 (0: none). */
+#define CATEGORY_FIRST 105u
+static const uint8_t CATEGORY_LOOKUP[12] IN_FLASH = {5, 0, 0, 4, 1, 0, 0, 0, 0, 0, 3, 2};
+static const uint8_t DIRECTION_FIRST[5] IN_FLASH = {98, 108, 100, 48, 97};
+static const uint8_t DIRECTION_SPAN[5] IN_FLASH = {20, 7, 21, 63, 20};
+static const uint16_t DIRECTION_OFFSET[5] IN_FLASH = {0, 20, 27, 48, 111};
+static const uint16_t DIRECTION_LOOKUP[131] IN_FLASH = {
+2, 0, 6, 0, 1, 0, 0, 0, 0, 0, 3, 0, 0, 0, 0, 0, 4, 0, 0, 5, /* move */
+7, 0, 0, 0, 0, 0, 8, /* turn */
+10, 0, 0, 0, 0, 0, 0, 0, 11, 0, 0, 0, 0, 0, 12, 0, 0, 9, 0, 0, 13, /* servo */
+14, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 16, 0, 0, 0, 0, 0, 0, 0, 15, /* laser */
+17, 0, 0, 0, 0, 0, 0, 0, 0, 0, 18, 21, 0, 0, 0, 0, 22, 0, 19, 20, /* init */
+};
+
+/* The category index + 1 of a first byte, or 0. */
+static uint8_t category_of(uint8_t byte) {
+  const uint8_t at = (uint8_t)(byte - CATEGORY_FIRST);
+  return at < sizeof CATEGORY_LOOKUP ? flash_byte(&CATEGORY_LOOKUP[at]) : 0;
+}
+
+bool dp_is_category(uint8_t byte) { return category_of(byte) != 0; }
+
+int dp_find_command(uint8_t category, uint8_t direction) {
+  const uint8_t c = category_of(category);
+  uint8_t at;
+  if (c == 0) return -1;
+  at = (uint8_t)(direction - flash_byte(&DIRECTION_FIRST[c - 1]));
+  if (at >= flash_byte(&DIRECTION_SPAN[c - 1])) return -1;
+  return (int)flash_word(&DIRECTION_LOOKUP[flash_word(&DIRECTION_OFFSET[c - 1]) + at]) - 1;
+}
+#else
 const dp_command_info *dp_command_info_of(dp_command_id id) {
   return (unsigned)id < DP_COMMAND_COUNT ? &COMMANDS[id] : NULL;
 }
+#endif
 
-const char *dp_command_name(dp_command_id id) {
-  return (unsigned)id < DP_COMMAND_COUNT ? COMMANDS[id].name : "unknown";
+const char *NAME_FUNCTION(dp_command_name)(dp_command_id id) {
+  return (unsigned)id < DP_COMMAND_COUNT ? flash_string(&COMMANDS[id].name) : UNKNOWN;
 }
 
-const char *dp_error_name(dp_error error) {
-  return (unsigned)error <= DP_ERROR_COUNT ? ERROR_NAMES[error] : "unknown";
+const char *NAME_FUNCTION(dp_error_name)(dp_error error) {
+  return (unsigned)error <= DP_ERROR_COUNT ? flash_string(&ERROR_NAMES[error]) : UNKNOWN;
 }
 
 char dp_error_code(dp_error error) {
-  return (unsigned)error <= DP_ERROR_COUNT ? ERROR_CODES[error] : '?';
+  return (unsigned)error <= DP_ERROR_COUNT ? (char)flash_byte(&ERROR_CODES[error]) : '?';
 }
 
 dp_error dp_error_from_code(char code) {
   unsigned i;
   for (i = 1; i <= DP_ERROR_COUNT; ++i) {
-    if (ERROR_CODES[i] == code) return (dp_error)i;
+    if ((char)flash_byte(&ERROR_CODES[i]) == code) return (dp_error)i;
   }
   return DP_ERROR_NONE;
 }
@@ -86,12 +219,13 @@ uint8_t dp_crc8(const uint8_t *data, size_t length) {
 }
 
 dp_error dp_encode(dp_command_id id, uint16_t value, uint8_t out[DP_WIRE_LENGTH]) {
-  const dp_command_info *info = dp_command_info_of(id);
+  const dp_command_info *info;
   int i;
-  if (info == NULL) return DP_ERROR_BAD_CATEGORY;
-  if (value < info->min || value > info->max) return DP_ERROR_OUT_OF_RANGE;
-  out[0] = info->category;
-  out[1] = info->direction;
+  if ((unsigned)id >= DP_COMMAND_COUNT) return DP_ERROR_BAD_CATEGORY;
+  info = &COMMANDS[id];
+  if (value < flash_word(&info->min) || value > flash_word(&info->max)) return DP_ERROR_OUT_OF_RANGE;
+  out[0] = flash_byte(&info->category);
+  out[1] = flash_byte(&info->direction);
   for (i = DP_FRAME_LENGTH - 1; i >= 2; --i) {
     out[i] = (uint8_t)('0' + value % 10u);
     value = (uint16_t)(value / 10u);
@@ -114,7 +248,7 @@ static dp_error finish(const uint8_t *frame, int8_t index, dp_command *out) {
   uint16_t value = 0;
   uint8_t i;
   for (i = 2; i < DP_FRAME_LENGTH; ++i) value = (uint16_t)(value * 10u + (uint8_t)(frame[i] - '0'));
-  if (value < COMMANDS[index].min || value > COMMANDS[index].max) return DP_ERROR_OUT_OF_RANGE;
+  if (value < flash_word(&COMMANDS[index].min) || value > flash_word(&COMMANDS[index].max)) return DP_ERROR_OUT_OF_RANGE;
   out->id = (dp_command_id)index;
   out->category = frame[0];
   out->direction = frame[1];
@@ -207,8 +341,8 @@ void dp_land(uint8_t out[DP_WIRE_LENGTH]) { (void)dp_encode(DP_CMD_LAND, 0, out)
 void dp_query_status(uint8_t out[DP_WIRE_LENGTH]) { (void)dp_encode(DP_CMD_QUERY_STATUS, 2, out); }
 
 void dp_stream_init(dp_stream_parser *parser) {
-  const dp_stream_parser empty = DP_STREAM_PARSER_INIT;
-  *parser = empty;
+  memset(parser, 0, sizeof *parser); /* DP_STREAM_PARSER_INIT, with no initializer kept in RAM on AVR */
+  parser->index = -1;
 }
 
 static void count(dp_stream_parser *parser, dp_error error) {
@@ -250,81 +384,56 @@ uint16_t dp_stream_error_count(const dp_stream_parser *parser, dp_error error) {
   return (error >= 1 && error <= DP_ERROR_COUNT) ? parser->counts[error - 1] : 0;
 }
 
-static const char *const REPLY_PREFIXES[] = {
-    "#READY",
-    "A",
-    "E",
-    "!F",
-};
+int dp_find_command_by_name(const char *name) {
+  for (int i = 0; name != NULL && i < DP_COMMAND_COUNT; ++i) {
+    if (flash_strcmp(name, flash_string(&COMMANDS[i].name)) == 0) return i;
+  }
+  return -1;
+}
 
-const char *dp_reply_prefix(dp_reply_kind kind) {
-  return (unsigned)kind < sizeof REPLY_PREFIXES / sizeof REPLY_PREFIXES[0] ? REPLY_PREFIXES[kind] : "";
+bool dp_command_default(dp_command_id id, uint16_t *value) {
+  if ((unsigned)id >= DP_COMMAND_COUNT || !flash_byte(&COMMANDS[id].has_default)) return false;
+  *value = flash_word(&COMMANDS[id].default_value);
+  return true;
+}
+
+const char *NAME_FUNCTION(dp_reply_prefix)(dp_reply_kind kind) {
+  return (unsigned)kind < REPLY_COUNT ? flash_string(&REPLY_PREFIXES[kind]) : EMPTY;
 }
 
 const dp_state dp_states[DP_STATE_COUNT] = {
 DP_STATE_DISARMED, DP_STATE_ARMING, DP_STATE_ARMED, DP_STATE_HOLD_ALTITUDE, DP_STATE_MOVING, DP_STATE_LANDING, DP_STATE_DISARMING, DP_STATE_SELF_TEST, DP_STATE_FAILSAFE
 };
 
-bool dp_state_armed(dp_state state) {
-  switch (state) {
-    case DP_STATE_ARMED:
-    case DP_STATE_HOLD_ALTITUDE:
-    case DP_STATE_MOVING:
-    case DP_STATE_LANDING:
-    case DP_STATE_DISARMING:
-      return true;
-    default:
-      return false;
-  }
+/* Is `code` one of the characters of `codes` (a string in flash on AVR)? */
+static bool code_in(int code, const char *codes) {
+  return code > 0 && code <= 255 && flash_strchr(codes, code) != NULL;
 }
 
-const char *dp_state_name(dp_state state) {
-  switch (state) {
-    case DP_STATE_DISARMED:
-      return "disarmed";
-    case DP_STATE_ARMING:
-      return "arming";
-    case DP_STATE_ARMED:
-      return "armed";
-    case DP_STATE_HOLD_ALTITUDE:
-      return "hold_altitude";
-    case DP_STATE_MOVING:
-      return "moving";
-    case DP_STATE_LANDING:
-      return "landing";
-    case DP_STATE_DISARMING:
-      return "disarming";
-    case DP_STATE_SELF_TEST:
-      return "self_test";
-    case DP_STATE_FAILSAFE:
-      return "failsafe";
-  }
-  return "unknown";
+bool dp_state_armed(dp_state state) { return code_in((int)state, ARMED_STATE_CODES); }
+
+const char *NAME_FUNCTION(dp_state_name)(dp_state state) {
+  if (!code_in((int)state, STATE_CODES)) return UNKNOWN;
+  return flash_string(&STATE_NAMES[flash_strchr(STATE_CODES, (int)state) - STATE_CODES]);
 }
 
-bool dp_is_state(uint8_t code) {
-  switch (code) {
-    case 'd':
-    case 'r':
-    case 'a':
-    case 'h':
-    case 'm':
-    case 'l':
-    case 'k':
-    case 't':
-    case 'f':
-      return true;
-    default:
-      return false;
-  }
-}
+bool dp_is_state(uint8_t code) { return code_in(code, STATE_CODES); }
 
 /* The ready line's one rule (the spec's replies.ready): after the prefix, exactly one space before each field;
    the protocol, the fingerprint's hex digits and a known integrity mode; nothing else. */
 #define READY_SEPARATOR ' '
-static const char READY_PROTOCOL_CHARACTERS[] = "0123456789_abcdefghijklmnopqrstuvwxyz";
-static const char READY_FINGERPRINT_CHARACTERS[] = "0123456789abcdef";
-static const char *const READY_INTEGRITY_MODES[] = {"none", "crc8"};
+static const char READY_PROTOCOL_CHARACTERS[] IN_FLASH = "0123456789_abcdefghijklmnopqrstuvwxyz";
+static const char READY_FINGERPRINT_CHARACTERS[] IN_FLASH = "0123456789abcdef";
+static const char READY_INTEGRITY_MODES_0[] IN_FLASH = "none";
+static const char READY_INTEGRITY_MODES_1[] IN_FLASH = "crc8";
+static const char *const READY_INTEGRITY_MODES[2] IN_FLASH = {
+    READY_INTEGRITY_MODES_0,
+    READY_INTEGRITY_MODES_1,
+};
+
+/* What the ready line says after its prefix, and the separator before the status. */
+static const char READY_TAIL[] IN_FLASH = " " DP_PROTOCOL_NAME " " DP_SPEC_FINGERPRINT " " DP_INTEGRITY;
+static const char STATUS_SEPARATOR[] IN_FLASH = DP_STATUS_SEPARATOR;
 
 /* The field after the separator at text[*at]: its length, or 0 (and *at unmoved) if no separator is there. */
 static size_t ready_field(const char *text, size_t length, size_t *at, const char **start) {
@@ -335,10 +444,11 @@ static size_t ready_field(const char *text, size_t length, size_t *at, const cha
   return n;
 }
 
+/* Are the `length` characters of `word` all in `set` (a string in flash on AVR)? */
 static bool all_in(const char *word, size_t length, const char *set) {
   size_t i;
   for (i = 0; i < length; ++i) {
-    if (word[i] == '\0' || strchr(set, word[i]) == NULL) return false;
+    if (word[i] == '\0' || flash_strchr(set, word[i]) == NULL) return false;
   }
   return true;
 }
@@ -350,8 +460,9 @@ static bool ready_fields_ok(const dp_reply *reply) {
   if (reply->fingerprint_length != 16 ||
       !all_in(reply->fingerprint, reply->fingerprint_length, READY_FINGERPRINT_CHARACTERS)) return false;
   for (i = 0; i < sizeof READY_INTEGRITY_MODES / sizeof READY_INTEGRITY_MODES[0]; ++i) {
-    const char *mode = READY_INTEGRITY_MODES[i];
-    if (strlen(mode) == reply->integrity_length && memcmp(mode, reply->integrity, reply->integrity_length) == 0) {
+    const char *mode = flash_string(&READY_INTEGRITY_MODES[i]);
+    if (flash_strlen(mode) == reply->integrity_length &&
+        flash_memcmp(reply->integrity, mode, reply->integrity_length) == 0) {
       return true;
     }
   }
@@ -360,11 +471,11 @@ static bool ready_fields_ok(const dp_reply *reply) {
 
 /* Reads the separator and status that end text[0..*length) and drops them from *length. */
 static bool take_status(const char *text, size_t *length, dp_status *status) {
-  const size_t separator = sizeof DP_STATUS_SEPARATOR - 1;
+  const size_t separator = sizeof STATUS_SEPARATOR - 1;
   const char *tail;
   if (*length < separator + 2) return false;
   tail = text + *length - separator - 2;
-  if (memcmp(tail, DP_STATUS_SEPARATOR, separator) != 0 || !dp_is_state((uint8_t)tail[separator])) return false;
+  if (flash_memcmp(tail, STATUS_SEPARATOR, separator) != 0 || !dp_is_state((uint8_t)tail[separator])) return false;
   if (tail[separator + 1] != DP_LASER_ON && tail[separator + 1] != DP_LASER_OFF) return false;
   status->state = (dp_state)tail[separator];
   status->laser_on = tail[separator + 1] == DP_LASER_ON;
@@ -378,9 +489,10 @@ dp_reply_status dp_parse_reply(const char *line, size_t length, dp_reply *reply)
   bool found = false;
   while (length > 0 && (line[length - 1] == '\n' || line[length - 1] == '\r')) --length;
   /* The longest matching prefix decides (the spec guarantees no prefix starts another). */
-  for (i = 0; i < sizeof REPLY_PREFIXES / sizeof REPLY_PREFIXES[0]; ++i) {
-    const size_t n = strlen(REPLY_PREFIXES[i]);
-    if (n <= length && memcmp(line, REPLY_PREFIXES[i], n) == 0 && (!found || n > prefix)) {
+  for (i = 0; i < REPLY_COUNT; ++i) {
+    const char *text = flash_string(&REPLY_PREFIXES[i]);
+    const size_t n = flash_strlen(text);
+    if (n <= length && flash_memcmp(line, text, n) == 0 && (!found || n > prefix)) {
       found = true;
       best = i;
       prefix = n;
@@ -414,13 +526,17 @@ dp_reply_status dp_parse_reply(const char *line, size_t length, dp_reply *reply)
   }
 }
 
+/* Copies `text` (in flash on AVR) to out[n..] without its NUL; returns the new length. */
 static size_t put(char *out, size_t n, const char *text) {
-  while (*text != '\0') out[n++] = *text++;
+  char c;
+  while ((c = (char)flash_byte(text++)) != '\0') out[n++] = c;
   return n;
 }
 
+static size_t put_prefix(char *out, dp_reply_kind kind) { return put(out, 0, flash_string(&REPLY_PREFIXES[kind])); }
+
 static size_t put_status(char *out, size_t n, dp_status status) {
-  n = put(out, n, DP_STATUS_SEPARATOR);
+  n = put(out, n, STATUS_SEPARATOR);
   out[n++] = (char)status.state;
   out[n++] = status.laser_on ? DP_LASER_ON : DP_LASER_OFF;
   return n;
@@ -433,37 +549,22 @@ static size_t end_line(char *out, size_t n) {
 }
 
 size_t dp_write_ready(char out[DP_REPLY_MAX_LENGTH]) {
-  const size_t n = put(out, 0, REPLY_PREFIXES[DP_REPLY_READY]);
-  return end_line(out, put(out, n, " " DP_PROTOCOL_NAME " " DP_SPEC_FINGERPRINT " " DP_INTEGRITY));
+  return end_line(out, put(out, put_prefix(out, DP_REPLY_READY), READY_TAIL));
 }
 
 size_t dp_write_accepted(const dp_command *command, dp_status status, char out[DP_REPLY_MAX_LENGTH]) {
-  size_t n = put(out, 0, REPLY_PREFIXES[DP_REPLY_ACCEPTED]);
+  size_t n = put_prefix(out, DP_REPLY_ACCEPTED);
   out[n++] = (char)command->category;
   out[n++] = (char)command->direction;
   return end_line(out, put_status(out, n, status));
 }
 
 size_t dp_write_rejected(dp_error error, dp_status status, char out[DP_REPLY_MAX_LENGTH]) {
-  size_t n = put(out, 0, REPLY_PREFIXES[DP_REPLY_REJECTED]);
+  size_t n = put_prefix(out, DP_REPLY_REJECTED);
   out[n++] = dp_error_code(error);
   return end_line(out, put_status(out, n, status));
 }
 
 size_t dp_write_failsafe(dp_status status, char out[DP_REPLY_MAX_LENGTH]) {
-  return end_line(out, put_status(out, put(out, 0, REPLY_PREFIXES[DP_REPLY_FAILSAFE]), status));
-}
-
-int dp_find_command_by_name(const char *name) {
-  for (int i = 0; name != NULL && i < DP_COMMAND_COUNT; ++i) {
-    if (strcmp(dp_command_name((dp_command_id)i), name) == 0) return i;
-  }
-  return -1;
-}
-
-bool dp_command_default(dp_command_id id, uint16_t *value) {
-  const dp_command_info *info = dp_command_info_of(id);
-  if (info == NULL || !info->has_default) return false;
-  *value = info->default_value;
-  return true;
+  return end_line(out, put_status(out, put_prefix(out, DP_REPLY_FAILSAFE), status));
 }

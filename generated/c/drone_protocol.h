@@ -4,9 +4,18 @@
 // Quadrotor drone protocol (Raspberry Pi to Arduino)
 //
 // C99 codec for any MCU or Linux program that is not an Arduino sketch: no heap, no stdio, no dependencies
-// beyond <stdbool.h>, <stddef.h> and <stdint.h>. Every name starts with dp_ / DP_.
+// beyond the C library's <stdbool.h>, <stddef.h>, <stdint.h> and <string.h> (and avr-libc's <avr/pgmspace.h> on
+// AVR). Every name starts with dp_ / DP_.
 // Pointer arguments must not be NULL, as for memcpy: no function checks them (a NULL frame is a crash, not an
 // error code).
+//
+// On AVR (__AVR__, avr-libc) the spec's tables and names live in flash (PROGMEM), so that encoding, decoding, the
+// stream parser and the replies use no static RAM (of the codec's, only the public dp_states array is in RAM).
+// The functions that return pointers to spec data keep their meaning there and are inline in this header, their
+// tables in RAM in the files that call them, and only there: dp_command_info_of(), dp_command_name(),
+// dp_error_name(), dp_state_name() and dp_reply_prefix(). Their _P variants return the same names
+// in flash at no RAM cost; read those with strcmp_P(), strlen_P(), printf_P(PSTR("%S"), name) or, in a sketch,
+// Serial.print((const __FlashStringHelper *)name).
 //
 //   dp_stream_parser parser = DP_STREAM_PARSER_INIT;
 //   dp_command command;
@@ -208,12 +217,70 @@ typedef struct dp_command_info {
   int8_t sense; /* +1 / -1 for servo moves, 0 otherwise */
 } dp_command_info;
 
+#ifndef __AVR__
 /* The command's description, or NULL for an id outside the spec. */
 const dp_command_info *dp_command_info_of(dp_command_id id);
 /* The command's name in the spec, or "unknown". */
 const char *dp_command_name(dp_command_id id);
 /* The error's name in the spec ("none", "unknown"). */
 const char *dp_error_name(dp_error error);
+#else
+/* The same names in flash (PGM_P), at no RAM cost: for strcmp_P(), strlen_P(), printf_P(PSTR("%S"), name) or
+   Serial.print((const __FlashStringHelper *)name). */
+const char *dp_command_name_P(dp_command_id id);
+const char *dp_error_name_P(dp_error error);
+/* The plain functions, as above, inline: their tables are in RAM, in each file that calls them and only there. */
+static inline const dp_command_info *dp_command_info_of(dp_command_id id) {
+  static const dp_command_info commands[DP_COMMAND_COUNT] = {
+      {"move_forward", 'm', 'f', 1000, 2000, 1600, true, DP_TARGET_PITCH, 0},
+      {"move_backward", 'm', 'b', 1000, 2000, 1400, true, DP_TARGET_PITCH, 0},
+      {"move_left", 'm', 'l', 1000, 2000, 1400, true, DP_TARGET_ROLL, 0},
+      {"move_right", 'm', 'r', 1000, 2000, 1600, true, DP_TARGET_ROLL, 0},
+      {"move_up", 'm', 'u', 1029, 2012, 1621, true, DP_TARGET_THROTTLE, 0},
+      {"move_down", 'm', 'd', 1029, 2012, 1421, true, DP_TARGET_THROTTLE, 0},
+      {"turn_left", 't', 'l', 1035, 2012, 1424, true, DP_TARGET_YAW, 0},
+      {"turn_right", 't', 'r', 1035, 2012, 1624, true, DP_TARGET_YAW, 0},
+      {"servo_up", 's', 'u', 1, 180, 0, false, DP_TARGET_TILT, 1},
+      {"servo_down", 's', 'd', 1, 180, 0, false, DP_TARGET_TILT, -1},
+      {"servo_left", 's', 'l', 1, 180, 0, false, DP_TARGET_PAN, -1},
+      {"servo_right", 's', 'r', 1, 180, 0, false, DP_TARGET_PAN, 1},
+      {"servo_reset", 's', 'x', 0, 0, 0, true, DP_TARGET_BOTH, 0},
+      {"laser_toggle", 'l', '0', 0, 0, 0, true, DP_TARGET_NONE, 0},
+      {"laser_on", 'l', 'n', 0, 0, 0, true, DP_TARGET_NONE, 0},
+      {"laser_off", 'l', 'f', 0, 1, 1, true, DP_TARGET_NONE, 0},
+      {"arm", 'i', 'a', 0, 0, 0, true, DP_TARGET_NONE, 0},
+      {"disarm", 'i', 'k', 0, 0, 0, true, DP_TARGET_NONE, 0},
+      {"hold_altitude", 'i', 's', 0, 1, 1, true, DP_TARGET_NONE, 0},
+      {"first_test", 'i', 't', 0, 0, 0, true, DP_TARGET_NONE, 0},
+      {"land", 'i', 'l', 0, 0, 0, true, DP_TARGET_NONE, 0},
+      {"query_status", 'i', 'q', 2, 2, 2, true, DP_TARGET_NONE, 0},
+};
+  return (unsigned)id < DP_COMMAND_COUNT ? &commands[id] : NULL;
+}
+static inline const char *dp_command_name(dp_command_id id) {
+  const dp_command_info *info = dp_command_info_of(id);
+  return info != NULL ? info->name : "unknown";
+}
+static inline const char *dp_error_name(dp_error error) {
+  static const char *const names[DP_ERROR_COUNT + 1] = {
+      "none",
+      "bad_category",
+      "bad_direction",
+      "bad_digit",
+      "out_of_range",
+      "timeout",
+      "too_short",
+      "too_long",
+      "not_armed",
+      "busy",
+      "unsupported",
+      "armed",
+      "airborne",
+      "bad_check",
+  };
+  return (unsigned)error <= DP_ERROR_COUNT ? names[error] : "unknown";
+}
+#endif
 /* The reply code letter of an error ('?' for none or unknown). */
 char dp_error_code(dp_error error);
 /* The error of a reply code letter, or DP_ERROR_NONE. */
@@ -224,6 +291,13 @@ int dp_find_command_by_name(const char *name);
 /* The command's default value in *value and true, or false for a command without one (or an unknown id). */
 bool dp_command_default(dp_command_id id, uint16_t *value);
 
+#ifdef __AVR__
+/* Is this byte a category? */
+bool dp_is_category(uint8_t byte);
+/* The command whose frame starts with these two bytes, or -1. In the .c on AVR, as reads of flash tables: gcc
+   would turn the switches below into lookup tables in RAM. */
+int dp_find_command(uint8_t category, uint8_t direction);
+#else
 /* Is this byte a category? */
 static inline bool dp_is_category(uint8_t byte) {
   switch (byte) {
@@ -314,6 +388,7 @@ static inline int dp_find_command(uint8_t category, uint8_t direction) {
       return -1;
   }
 }
+#endif
 
 /* CRC-8/SMBUS (polynomial 0x07, initial value 0, no reflection): the check of the crc8 integrity mode. */
 uint8_t dp_crc8(const uint8_t *data, size_t length);
@@ -429,8 +504,20 @@ typedef struct dp_status {
 
 /* May the motors spin in this state? */
 bool dp_state_armed(dp_state state);
+#ifndef __AVR__
 /* The state's name in the spec, or "unknown". */
 const char *dp_state_name(dp_state state);
+#else
+const char *dp_state_name_P(dp_state state); /* in flash, as dp_command_name_P() */
+static inline const char *dp_state_name(dp_state state) {
+  static const char *const names[DP_STATE_COUNT] = {"disarmed", "arming", "armed", "hold_altitude", "moving", "landing", "disarming", "self_test", "failsafe"};
+  int i;
+  for (i = 0; i < DP_STATE_COUNT; ++i) {
+    if (dp_states[i] == state) return names[i];
+  }
+  return "unknown";
+}
+#endif
 /* Is this byte a state's code? */
 bool dp_is_state(uint8_t code);
 
@@ -463,8 +550,16 @@ typedef enum dp_reply_status {
 
 /* Parse one reply line of `length` bytes (with or without its "\n" / "\r\n"). */
 dp_reply_status dp_parse_reply(const char *line, size_t length, dp_reply *reply);
-/* The text a line of this kind starts with. */
+#ifndef __AVR__
+/* The text a line of this kind starts with ("" for an unknown kind). */
 const char *dp_reply_prefix(dp_reply_kind kind);
+#else
+const char *dp_reply_prefix_P(dp_reply_kind kind); /* in flash, as dp_command_name_P() */
+static inline const char *dp_reply_prefix(dp_reply_kind kind) {
+  static const char *const prefixes[] = {"#READY", "A", "E", "!F"};
+  return (unsigned)kind < sizeof prefixes / sizeof prefixes[0] ? prefixes[kind] : "";
+}
+#endif
 
 /* Each writes one reply line ending in '\n' into `out` (no NUL) and returns its length. */
 size_t dp_write_ready(char out[DP_REPLY_MAX_LENGTH]);

@@ -8,6 +8,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tarfile
 import tomllib
 import venv
 import zipfile
@@ -151,3 +152,23 @@ def test_the_crate_package_holds_its_readme_and_license_with_complete_metadata(t
     package = tomllib.loads((crate / "Cargo.toml").read_text(encoding="utf-8"))["package"]
     assert package["documentation"] == f"https://docs.rs/{package['name']}"
     assert "homepage" not in package and "repository" not in package  # none public: no placeholder
+
+
+def test_the_crate_packages_with_no_warning_and_its_tests_run_from_the_package(tmp_path: Path) -> None:
+    crate, target = tmp_path / "crate", tmp_path / "target"
+    shutil.copytree(ROOT / "generated" / "rust", crate)  # cargo writes nothing into the repository
+    env = {"CARGO_TARGET_DIR": str(target)}
+    packaged = _run("cargo", "package", "--locked", "--offline", cwd=crate, env_extra=env)
+    assert packaged.returncode == 0, packaged.stderr
+    # e.g. "ignoring test `vectors` as `tests/vectors.rs` is not included in the published package"
+    assert "warning" not in packaged.stderr.lower(), packaged.stderr
+    (archive,) = (target / "package").glob("*.crate")
+    with tarfile.open(archive) as tar:
+        tar.extractall(tmp_path / "unpacked", filter="data")
+    (unpacked,) = (tmp_path / "unpacked").iterdir()
+    assert (unpacked / "tests" / "vectors.json").read_bytes() == (ROOT / "generated" / "vectors.json").read_bytes()
+    # the packaged vectors test (the doctests run in make rust-test)
+    tested = _run("cargo", "test", "--locked", "--offline", "--quiet", "--test", "vectors", cwd=unpacked, env_extra=env)
+    assert tested.returncode == 0, tested.stdout + tested.stderr
+    tests = (unpacked / "tests" / "vectors.rs").read_text(encoding="utf-8").count("#[test]")
+    assert f"test result: ok. {tests} passed; 0 failed" in tested.stdout, tested.stdout
