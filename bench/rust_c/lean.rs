@@ -1,11 +1,13 @@
 //! The Rust codec against lean hand-written floors, in instructions (run under callgrind, one function counted
 //! per run). Usage: lean write <dir> (the inputs: clean.bin, garbage.bin, distinct.bin) | lean <mode> <file>
-//! with mode stream, floor_stream, decode or floor_decode.
+//! with mode stream, floor_stream, decode or floor_decode | lean time <dir> (ns per unit, codec and floor, best
+//! of 31 interleaved runs, for each input).
 //!
 //! The floors know only the frame format: tables built here from the crate's `COMMANDS` (a category byte's
 //! slot, a direction byte's command, each command's range), each byte checked as it arrives and a slide of one
 //! byte on an invalid one, but no timeouts, no error kinds or counts and no `last_error`.
 use std::hint::black_box;
+use std::time::Instant;
 
 use drone_protocol::{decode, encode, StreamParser, COMMANDS, FRAME_LENGTH, WIRE_LENGTH};
 
@@ -201,10 +203,33 @@ fn write(dir: &str, size: usize) {
     std::fs::write(format!("{dir}/distinct.bin"), all.concat()).expect("distinct.bin");
 }
 
+/// Best ns per unit of the codec and of the floor on each input, timed alternately.
+fn time(dir: &str) {
+    let t = Lean::new();
+    for (name, unit) in [("clean", 1), ("garbage", 1), ("distinct", FRAME_LENGTH)] {
+        let input = std::fs::read(format!("{dir}/{name}.bin")).expect("an input file");
+        let units = (input.len() / unit) as f64;
+        let (mut ours, mut floor) = (f64::INFINITY, f64::INFINITY);
+        for _ in 0..31 {
+            let start = Instant::now();
+            black_box(if unit == 1 { bench_stream(black_box(&input)) } else { bench_decode(black_box(&input)) });
+            ours = ours.min(start.elapsed().as_nanos() as f64 / units);
+            let start = Instant::now();
+            black_box(if unit == 1 { floor_stream(&t, black_box(&input)) } else { floor_decode(&t, black_box(&input)) });
+            floor = floor.min(start.elapsed().as_nanos() as f64 / units);
+        }
+        println!("{name} {ours:.3} {floor:.3}");
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args[1] == "write" {
         write(&args[2], args.get(3).map_or(200_000, |n| n.parse().expect("a size")));
+        return;
+    }
+    if args[1] == "time" {
+        time(&args[2]);
         return;
     }
     let input = std::fs::read(&args[2]).expect("an input file");
