@@ -12,7 +12,7 @@ use std::time::Instant;
 use drone_protocol::{decode, encode, StreamParser, COMMANDS, FRAME_LENGTH, WIRE_LENGTH};
 
 /// The floor's tables.
-struct Lean {
+pub struct Lean {
     category: [u16; 256],      // slot + 1 of a category byte (0: none)
     command: Vec<[u16; 256]>,  // by slot: the command + 1 of a direction byte (0: none)
     range: Vec<(u32, u32)>,    // by command
@@ -86,7 +86,7 @@ impl State {
 
 #[no_mangle]
 #[inline(never)]
-pub extern "C" fn floor_stream(t: &Lean, bytes: &[u8]) -> usize {
+pub fn floor_stream(t: &Lean, bytes: &[u8]) -> usize {
     let mut s = State::default();
     let mut found = 0;
     for &b in bytes {
@@ -125,7 +125,7 @@ pub extern "C" fn floor_stream(t: &Lean, bytes: &[u8]) -> usize {
 
 #[no_mangle]
 #[inline(never)]
-pub extern "C" fn bench_stream(bytes: &[u8]) -> usize {
+pub fn bench_stream(bytes: &[u8]) -> usize {
     let mut parser = StreamParser::new();
     let mut found = 0;
     for &b in bytes {
@@ -136,7 +136,7 @@ pub extern "C" fn bench_stream(bytes: &[u8]) -> usize {
 
 #[no_mangle]
 #[inline(never)]
-pub extern "C" fn floor_decode(t: &Lean, frames: &[u8]) -> usize {
+pub fn floor_decode(t: &Lean, frames: &[u8]) -> usize {
     let mut sum = 0;
     for f in frames.chunks_exact(FRAME_LENGTH) {
         let mut s = State::default();
@@ -149,7 +149,7 @@ pub extern "C" fn floor_decode(t: &Lean, frames: &[u8]) -> usize {
 
 #[no_mangle]
 #[inline(never)]
-pub extern "C" fn bench_decode(frames: &[u8]) -> usize {
+pub fn bench_decode(frames: &[u8]) -> usize {
     frames.chunks_exact(WIRE_LENGTH).map(|f| decode(f).map_or(0, |c| usize::from(c.value))).sum()
 }
 
@@ -175,7 +175,7 @@ fn frame(i: usize, value: u16) -> [u8; WIRE_LENGTH] {
 /// distinct.bin: distinct valid frames (every command at distinct values, shuffled).
 fn write(dir: &str, size: usize) {
     let mut r = Random(0x9E37_79B9_7F4A_7C15);
-    let mut pick = |r: &mut Random| {
+    let pick = |r: &mut Random| {
         let i = r.below(COMMANDS.len());
         let c = &COMMANDS[i];
         frame(i, c.min + r.below(usize::from(c.max - c.min) + 1) as u16)
