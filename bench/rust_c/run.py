@@ -111,8 +111,10 @@ def main() -> None:
         "",
     ])
     print(text)
-    if not args.no_write:
-        (HERE / "RESULTS.md").write_text(text, encoding="utf-8")
+    if not args.no_write:  # instructions.py's section is kept
+        results = HERE / "RESULTS.md"
+        kept = results.read_text(encoding="utf-8").partition("## Instructions against lean floors")
+        results.write_text(text + ("\n" + kept[1] + kept[2] if kept[1] else ""), encoding="utf-8")
 
 
 if __name__ == "__main__":

@@ -5,7 +5,7 @@
 //   stream   StreamParser.feed per byte vs a 6-byte accumulator that slice-and-parses each full buffer
 // Goal: each at most 2x its floor. Each figure is the median of 9 rounds over 1024 frames of every command at
 // random values; writes bench/typescript/RESULTS.md (--no-write: print only).
-import { writeFileSync } from "node:fs";
+import { existsSync, readFileSync, writeFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath, pathToFileURL } from "node:url";
 
@@ -133,4 +133,10 @@ for (const group of results) {
 lines.push("");
 console.log(lines.join("\n"));
 if (sink === 0.5) console.log("unreachable"); // keeps `sink` alive
-if (!process.argv.includes("--no-write")) writeFileSync(join(here, "RESULTS.md"), lines.join("\n"));
+if (!process.argv.includes("--no-write")) {
+  // instructions.py's section is kept
+  const results = join(here, "RESULTS.md");
+  const old = existsSync(results) ? readFileSync(results, "utf8") : "";
+  const kept = old.indexOf("## Instructions against lean floors");
+  writeFileSync(results, lines.join("\n") + (kept >= 0 ? "\n" + old.slice(kept) : ""));
+}

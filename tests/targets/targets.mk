@@ -80,3 +80,4 @@ c-fuzz: $(TARGETS_BUILD)/fuzz_c_codec $(TARGETS_BUILD)/c.dict
 bench: bench-rust-c
 bench-rust-c: deps cargo-available
 	$(PY) bench/rust_c/run.py
+	$(PY) bench/rust_c/instructions.py

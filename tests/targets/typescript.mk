@@ -7,8 +7,8 @@
 #                            examples of the README and the docs, the bench console in headless Chromium against
 #                            the virtual drone (part of `make test`)
 #   make typescript-console  the virtual drone behind a WebSocket bridge, for the console in a browser by hand
-#   make bench-typescript    encode/decode per frame and stream parser per byte against hand-written floors;
-#                            writes bench/typescript/RESULTS.md
+#   make bench-typescript    encode/decode per frame and stream parser per byte against hand-written floors, in
+#                            time and in instructions (callgrind); writes bench/typescript/RESULTS.md
 #
 # The test tools (typescript, playwright-core, ws) are pinned in tests/targets/typescript/package-lock.json and
 # installed into tests/targets/typescript/node_modules: nothing global. Chromium comes from Debian.
@@ -60,6 +60,7 @@ typescript-test: $(TS_STAMP) $(TS_CHROMIUM) $(VENV_STAMP) $(FW_HOST_DIR)/virtual
 typescript-console: $(TS_STAMP) $(FW_HOST_DIR)/virtual_drone
 	$(TS_ENV) node $(TS_TOOLS_DIR)/ws_bridge.mjs
 
-bench-typescript: $(TS_STAMP)
+bench-typescript: $(TS_STAMP) $(VENV_STAMP)
 	$(TS_ENV) node bench/typescript/bench.mjs
+	$(PY) bench/typescript/instructions.py
 bench: bench-typescript

@@ -164,16 +164,12 @@ impl Category {
     /// Every category, in spec order.
     pub const ALL: [Category; 5] = [Category::Move, Category::Turn, Category::Servo, Category::Laser, Category::Init];
 
-    /// The category of a first byte.
+    /// The category of a first byte (a table lookup: [`CATEGORY_SLOT`]).
     #[inline]
     pub const fn from_code(byte: u8) -> Option<Category> {
-        match byte {
-            b'm' => Some(Category::Move),
-            b't' => Some(Category::Turn),
-            b's' => Some(Category::Servo),
-            b'l' => Some(Category::Laser),
-            b'i' => Some(Category::Init),
-            _ => None,
+        match CATEGORY_SLOT[byte as usize] {
+            0 => None,
+            slot => Some(Category::ALL[slot as usize - 1]),
         }
     }
 
@@ -716,36 +712,41 @@ impl CommandId {
         self.info().name
     }
 
-    /// The command whose frame starts with these two bytes.
+    /// The command whose frame starts with these two bytes (two table lookups: [`COMMAND_AT`]).
     #[inline]
     pub const fn from_codes(category: u8, direction: u8) -> Option<CommandId> {
-        match (category, direction) {
-            (b'm', b'f') => Some(CommandId::MoveForward),
-            (b'm', b'b') => Some(CommandId::MoveBackward),
-            (b'm', b'l') => Some(CommandId::MoveLeft),
-            (b'm', b'r') => Some(CommandId::MoveRight),
-            (b'm', b'u') => Some(CommandId::MoveUp),
-            (b'm', b'd') => Some(CommandId::MoveDown),
-            (b't', b'l') => Some(CommandId::TurnLeft),
-            (b't', b'r') => Some(CommandId::TurnRight),
-            (b's', b'u') => Some(CommandId::ServoUp),
-            (b's', b'd') => Some(CommandId::ServoDown),
-            (b's', b'l') => Some(CommandId::ServoLeft),
-            (b's', b'r') => Some(CommandId::ServoRight),
-            (b's', b'x') => Some(CommandId::ServoReset),
-            (b'l', b'0') => Some(CommandId::LaserToggle),
-            (b'l', b'n') => Some(CommandId::LaserOn),
-            (b'l', b'f') => Some(CommandId::LaserOff),
-            (b'i', b'a') => Some(CommandId::Arm),
-            (b'i', b'k') => Some(CommandId::Disarm),
-            (b'i', b's') => Some(CommandId::HoldAltitude),
-            (b'i', b't') => Some(CommandId::FirstTest),
-            (b'i', b'l') => Some(CommandId::Land),
-            (b'i', b'q') => Some(CommandId::QueryStatus),
-            _ => None,
+        if direction < 128 {
+            COMMAND_AT[CATEGORY_SLOT[category as usize] as usize][direction as usize]
+        } else {
+            None
         }
     }
 }
+
+/// Each byte's slot as a first byte: its index in [`Category::ALL`] + 1, or 0 when it is no category. Tables
+/// rather than matches: a lookup costs the same for any spec and has no branch to mispredict.
+pub(crate) const CATEGORY_SLOT: [u8; 256] = {
+    let mut table = [0; 256];
+    let mut i = 0;
+    while i < Category::ALL.len() {
+        table[Category::ALL[i] as usize] = i as u8 + 1;
+        i += 1;
+    }
+    table
+};
+
+/// The command of a category slot (row 0: no category) and a direction byte; codes are printable ASCII, so
+/// a row holds the bytes below 128.
+pub(crate) const COMMAND_AT: [[Option<CommandId>; 128]; Category::ALL.len() + 1] = {
+    let mut table = [[None; 128]; Category::ALL.len() + 1];
+    let mut i = 0;
+    while i < COMMANDS.len() {
+        let info = &COMMANDS[i];
+        table[CATEGORY_SLOT[info.category as usize] as usize][info.direction as usize] = Some(CommandId::ALL[i]);
+        i += 1;
+    }
+    table
+};
 
 /// One decoded command.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -850,14 +851,14 @@ pub fn decode(bytes: &[u8]) -> Result<Command, Error> {
         Err(_) if bytes.len() < WIRE_LENGTH => return Err(Error::TooShort),
         Err(_) => return Err(Error::TooLong),
     };
-    let mut id = None;
-    for pos in 0..WIRE_LENGTH {
-        check_byte(frame, pos, &mut id)?;
+    // The command from its two bytes at once; which of them is wrong only when neither fits.
+    let Some(id) = CommandId::from_codes(frame[0], frame[1]) else {
+        return Err(if Category::from_code(frame[0]).is_none() { Error::BadCategory } else { Error::BadDirection });
+    };
+    for pos in 2..WIRE_LENGTH {
+        check_byte(frame, pos, &mut Some(id))?;
     }
-    match id {
-        Some(id) => finish(frame, id),
-        None => Err(Error::BadDirection),
-    }
+    finish(frame, id)
 }
 
 const _: () = assert!(VALUE_WIDTH <= 4, "values are held in 16 bits");

@@ -7,10 +7,6 @@ use crate::{
     check_byte, finish, Category, Command, CommandId, Error, Frame, FRAME_LENGTH, INTER_BYTE_TIMEOUT_MS, WIRE_LENGTH,
 };
 
-/// While the buffer holds fewer bytes than this, a digit needs no check beyond being a digit: it does not
-/// complete the frame (the fast path).
-const DIGITS_END: usize = FRAME_LENGTH - 1;
-
 /// The error kinds a stream parser meets and counts.
 pub const STREAM_ERRORS: [Error; 5] =
     [Error::BadCategory, Error::BadDirection, Error::BadDigit, Error::OutOfRange, Error::Timeout];
@@ -59,13 +55,20 @@ impl StreamParser {
             self.length = 0;
         }
         self.last_ms = now_ms;
-        // The common cases, each a check of the new byte alone (the buffer holds a valid prefix):
+        // The fast paths, each a check of the new byte alone (the buffer holds a valid prefix); anything else,
+        // and an out-of-range frame, goes to append(), which slides.
         let length = self.length;
         if length >= 2 {
-            if length < DIGITS_END && byte.is_ascii_digit() {
-                self.buffer[length] = byte; // a middle digit
-                self.length = length + 1;
-                return None;
+            if length < FRAME_LENGTH && byte.is_ascii_digit() {
+                self.buffer[length] = byte;
+                if length + 1 < WIRE_LENGTH {
+                    self.length = length + 1; // a digit that does not complete the frame
+                    return None;
+                }
+                if let Some(Ok(command)) = self.id.map(|id| finish(&self.buffer, id)) {
+                    self.length = 0; // the last digit (no check characters) of a frame in range
+                    return Some(command);
+                }
             }
         } else if length == 1 {
             if let Some(id) = CommandId::from_codes(self.buffer[0], byte) {
@@ -74,9 +77,13 @@ impl StreamParser {
                 self.length = 2;
                 return None;
             }
-        } else if Category::from_code(byte).is_some() {
-            self.buffer[0] = byte;
-            self.length = 1;
+        } else {
+            if Category::from_code(byte).is_some() {
+                self.buffer[0] = byte;
+                self.length = 1;
+            } else {
+                self.count(Error::BadCategory); // garbage between frames: nothing pending, nothing to slide
+            }
             return None;
         }
         self.append(byte)

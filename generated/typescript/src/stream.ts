@@ -8,6 +8,11 @@ import { type Command, type CommandEntry, checkText, isCategory, lookup, require
 import { ERRORS, FRAME_LENGTH, INTER_BYTE_TIMEOUT_MS, WIRE_LENGTH, type ErrorName } from "./spec.js";
 
 const KINDS = Object.keys(ERRORS) as ErrorName[];
+// Counters by the kind's index in KINDS: a number array, not a Map keyed by name, on the per-byte paths.
+const KIND_INDEX = new Map<ErrorName, number>(KINDS.map((name, i) => [name, i]));
+const BAD_CATEGORY = KINDS.indexOf("bad_category");
+const BAD_DIRECTION = KINDS.indexOf("bad_direction");
+const TIMEOUT = KINDS.indexOf("timeout");
 
 /**
  * Finds frames in a byte stream that may hold garbage, lost bytes and pauses.
@@ -23,8 +28,8 @@ export class StreamParser {
   private length = 0;
   private entry: CommandEntry | undefined = undefined; // the command of buffer[0..1], while length >= 2
   private lastMs = 0;
-  private readonly counts = new Map<ErrorName, number>(KINDS.map((name) => [name, 0]));
-  private first: ErrorName | null = null;
+  private readonly counts: number[] = KINDS.map(() => 0);
+  private first = -1; // the index of the first error of the last feed(), -1: none
 
   /**
    * Feed one byte received at `nowMs` (whole milliseconds, e.g. `Math.floor(performance.now())`; differences
@@ -37,14 +42,55 @@ export class StreamParser {
         ? `StreamParser.feed() takes one byte (a number), not ${typeof byte}: feedAll() takes a Uint8Array`
         : `StreamParser.feed() needs the time in whole milliseconds, e.g. Math.floor(performance.now()), not ${nowMs}`);
     }
-    this.first = null;
-    if (this.length > 0 && (nowMs - this.lastMs) >>> 0 > INTER_BYTE_TIMEOUT_MS) {
-      this.count("timeout");
-      this.length = 0;
+    this.first = -1;
+    let length = this.length;
+    if (length > 0 && (nowMs - this.lastMs) >>> 0 > INTER_BYTE_TIMEOUT_MS) {
+      this.count(TIMEOUT);
+      this.length = length = 0;
     }
     this.lastMs = nowMs;
     byte &= 0xff;
-    return this.append(byte);
+    // The fast paths, each a check of the new byte alone (the buffer holds a valid prefix): a byte that starts
+    // a frame or is garbage between frames, a direction, a digit. A wrong direction leaves the new byte alone
+    // after the slide; anything else wrong, and an out-of-range frame, goes to append(), which slides.
+    if (length >= 2) {
+      if (length < FRAME_LENGTH && byte >= 0x30 && byte <= 0x39) {
+        this.buffer[length] = byte;
+        if (length + 1 < WIRE_LENGTH) {
+          this.length = length + 1; // a digit that does not complete the frame
+          return null;
+        }
+        const command = this.finish(); // the last digit (no check characters)
+        if (command !== null) {
+          this.length = 0;
+          return command;
+        }
+      }
+      return this.append(byte);
+    }
+    if (length === 1) {
+      const entry = lookup(this.buffer[0] ?? 0, byte);
+      if (entry !== undefined) {
+        this.entry = entry;
+        this.buffer[1] = byte;
+        this.length = 2;
+        return null;
+      }
+      this.count(BAD_DIRECTION);
+    }
+    return this.start(byte);
+  }
+
+  // A byte with nothing pending before it: the start of a frame, or garbage between frames (nothing to slide).
+  private start(byte: number): null {
+    if (isCategory(byte)) {
+      this.buffer[0] = byte;
+      this.length = 1;
+    } else {
+      this.count(BAD_CATEGORY);
+      this.length = 0;
+    }
+    return null;
   }
 
   /** Feed bytes that arrived together at `nowMs`; returns the commands they complete, in order. */
@@ -60,16 +106,16 @@ export class StreamParser {
 
   /** The first error of the last feed(), or null. */
   get lastError(): ErrorName | null {
-    return this.first;
+    return KINDS[this.first] ?? null;
   }
 
   /** How many times each kind was met (every kind of the spec; those of STREAM_ERRORS only are ever counted). */
   get errors(): Readonly<Record<string, number>> {
-    return Object.freeze(Object.fromEntries(this.counts));
+    return Object.freeze(Object.fromEntries(KINDS.map((name, i) => [name, this.counts[i] ?? 0])));
   }
 
   errorCount(name: ErrorName): number {
-    return this.counts.get(name) ?? 0;
+    return this.counts[KIND_INDEX.get(name) ?? -1] ?? 0;
   }
 
   /** Bytes of a frame started but not complete. */
@@ -82,10 +128,12 @@ export class StreamParser {
     this.length = 0;
     this.entry = undefined;
     this.lastMs = 0;
-    this.first = null;
-    for (const name of KINDS) this.counts.set(name, 0);
+    this.first = -1;
+    this.counts.fill(0);
   }
 
+  // Append a byte that needs checking; on an invalid prefix, slide forward one byte at a time until the buffer
+  // holds a valid prefix again.
   private append(byte: number): Command | null {
     const buffer = this.buffer;
     buffer[this.length++] = byte;
@@ -94,24 +142,31 @@ export class StreamParser {
     while (this.length > 0) {
       let error: ErrorName | null = null;
       for (let pos = from; pos < this.length && error === null; pos++) error = this.checkByte(pos);
-      let value = 0;
-      if (error === null && this.length === WIRE_LENGTH) {
-        for (let i = 2; i < FRAME_LENGTH; i++) value = value * 10 + ((buffer[i] ?? 0) - 0x30);
-        const spec = (this.entry as CommandEntry).spec;
-        if (value < spec.minimum || value > spec.maximum) error = "out_of_range";
-      }
       if (error === null) {
         if (this.length < WIRE_LENGTH) return null;
-        this.length = 0;
-        const spec = (this.entry as CommandEntry).spec;
-        return { name: spec.name, category: spec.category, direction: spec.direction, value };
+        const command = this.finish();
+        if (command !== null) {
+          this.length = 0;
+          return command;
+        }
+        error = "out_of_range";
       }
-      this.count(error);
+      this.count(KIND_INDEX.get(error) ?? -1);
       this.length--;
       buffer.copyWithin(0, 1, this.length + 1);
       from = 0;
     }
     return null;
+  }
+
+  // The command of a whole frame whose bytes are all valid, or null when its value is out of range.
+  private finish(): Command | null {
+    const buffer = this.buffer;
+    let value = 0;
+    for (let i = 2; i < FRAME_LENGTH; i++) value = value * 10 + ((buffer[i] ?? 0) - 0x30);
+    const spec = (this.entry as CommandEntry).spec;
+    if (value < spec.minimum || value > spec.maximum) return null;
+    return { name: spec.name, category: spec.category, direction: spec.direction, value };
   }
 
   // Is byte `pos` of the buffer valid, given that the bytes before it are? At byte 1, sets the entry.
@@ -128,8 +183,8 @@ export class StreamParser {
     return byte >= 0x30 && byte <= 0x39 ? null : "bad_digit";
   }
 
-  private count(error: ErrorName): void {
-    if (this.first === null) this.first = error;
-    this.counts.set(error, (this.counts.get(error) ?? 0) + 1);
+  private count(kind: number): void {
+    if (this.first < 0) this.first = kind;
+    this.counts[kind] = (this.counts[kind] ?? 0) + 1;
   }
 }
