@@ -57,3 +57,20 @@ def table(sets: list[tuple[str, tuple[str, ...]]], n: int) -> list[str]:
         dw, dc = [x for m in ms for x in m[2]], [x for m in ms for x in m[3]]
         out.append(row(f"all sets, {w}x{h}", (fw, fc, dw, dc, sum(m[4] for m in ms))))
     return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The cost table alone, every set of sources_run.py (``PYTHONPATH=.:bench/vision .venv/bin/python
+    bench/vision/sources_time.py --views 200``): a change's cost measured without the accuracy runs."""
+    import sources_run
+    import vision_eval as ve
+
+    args = ve.counts_args(main.__doc__, argv, views=(200, "views timed per set at 320x240"))
+    print("\n".join(table([(s.label, s.names) for s in sources_run.sets() if s.names], args.views)))
+    return 0
+
+
+if __name__ == "__main__":
+    import sys
+
+    sys.exit(main())
