@@ -16,6 +16,10 @@
 #                         the report's seeds), every candidate recorded in build/vision-dev/$(VISION_DEV_RECORD)
 #                         (default: current), about 3 minutes on 2 cores; compare two records with
 #                         bench/vision/vision_dev.py compare A B (how bench/vision/HISTORY.md measures a change)
+#   make bench-vision-sources  the detectors on five packaged sources (scikit-image, scikit-learn, avr-libc,
+#                         opencv-doc's photos and videos, matplotlib), split by source into tuning and held-out;
+#                         installs the bench extra (pip) and Debian's opencv-doc; about 10 minutes on 2 cores; writes
+#                         bench/vision/RESULTS-sources.md (BENCH_VISION_SOURCES_FLAGS="--views 20 --timing 20": smoke)
 #   make bench-tools      the standalone codec wheel's size and import time vs json; the live view's frame
 #                         latency and the pilot loop's rate with and without a viewer; writes bench/tools/RESULTS.md
 #   make bench-flight     the closed-loop campaign in the MuJoCo simulator: seeded flights per detector across
@@ -37,11 +41,13 @@ BENCH_PROTOCOL_BUILD ?= build/bench/protocol
 BENCH_PROTOCOL_FLAGS ?=
 
 BENCH_VISION_FLAGS ?=
+BENCH_VISION_SOURCES_FLAGS ?=
+BENCH_VISION_APT := opencv-doc avr-libc  # the packaged imagery of bench-vision-sources (bench/vision/packaged.py)
 VISION_DEV_RECORD ?= current
 BENCH_FLIGHT_FLAGS ?=
 
-.PHONY: bench bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-vision-dev bench-ide bench-tools \
-        bench-flight bench-flight-strict bench-sidechan
+.PHONY: bench bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-vision-sources bench-vision-dev \
+        bench-ide bench-tools bench-flight bench-flight-strict bench-sidechan
 
 # Run benchmarks one at a time (not with make -j): they time each other otherwise.
 bench: bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-ide bench-rust-c bench-tools \
@@ -60,6 +66,17 @@ bench-flight-strict: deps firmware-host
 
 bench-vision: deps
 	PYTHONPATH=.:bench/vision $(PY) bench/vision/run.py $(BENCH_VISION_FLAGS)
+
+bench-vision-sources: deps
+	@missing=$$(for p in $(BENCH_VISION_APT); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null \
+	    | grep -q "install ok installed" || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+	  if [ "$$(id -u)" = 0 ]; then echo "Installing Debian packages:" $$missing; apt-get update -qq && \
+	    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null || exit 1; \
+	  else echo "Missing Debian packages. Run:  sudo apt-get install -y $$missing"; exit 1; fi; \
+	fi
+	$(PY) -m pip install -q -e '.[bench]'
+	PYTHONPATH=.:bench/vision $(PY) bench/vision/sources_run.py $(BENCH_VISION_SOURCES_FLAGS)
 
 bench-vision-dev: deps
 	PYTHONPATH=.:bench/vision $(PY) bench/vision/vision_dev.py record $(VISION_DEV_RECORD)

@@ -23,10 +23,11 @@ FLOOR_RANGE = (np.array((0, 120, 70), np.uint8), np.array((8, 255, 255), np.uint
 SOURCES = vi.TUNING + vi.HELD_OUT + vi.VALIDATION + vi.BENCH
 
 
-def frames(rng: np.random.Generator, name: str, n: int, size: tuple[int, int]) -> list[vi.Image]:
+def frames(rng: np.random.Generator, names: tuple[str, ...], n: int, size: tuple[int, int]) -> list[vi.Image]:
+    """``n`` views of ``names`` at ``size``: every other one with a ball 16-80 px, half of each kind noisy."""
     out = []
     for k in range(n):
-        img = vi.target_sample(rng, (name,), "clean", "ball", (16, 80)).image if k % 2 else vi.view(rng, (name,))
+        img = vi.target_sample(rng, names, "clean", "ball", (16, 80)).image if k % 2 else vi.view(rng, names)
         if k % 4 >= 2:
             img = np.clip(img.astype(np.int16) + rng.normal(0, 12, img.shape), 0, 255).astype(np.uint8)
         out.append(np.asarray(cv2.resize(img, size), np.uint8))
@@ -60,7 +61,7 @@ def main(argv: list[str] | None = None) -> int:
         fl, wall, cpu = every.setdefault(size, ([], [], []))
         for name in names:
             f0, w0, c0, cut = [], [], [], 0
-            for img in frames(rng, name, n, size):
+            for img in frames(rng, (name,), n, size):
                 f0.append(clocked(floor, img)[0])
                 w, c = clocked(det.candidates, img)
                 w0.append(w)

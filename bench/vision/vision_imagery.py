@@ -43,9 +43,15 @@ CORNER_SHARE = 0.12  # of a marker's black square covered at one corner (ArUco's
 
 @cache
 def photo(name: str) -> Image:
-    """A photograph as BGR uint8 (motorcycle_left/right: the two views of skimage's stereo pair)."""
+    """A photograph as BGR uint8 (motorcycle_left/right: the two views of skimage's stereo pair); a name
+    ``<source>:<file>`` is one of packaged.py's stills."""
     import skimage.data
 
+    if ":" in name and not name.startswith("scikit-image:"):
+        import packaged
+
+        return packaged.load(name)
+    name = name.removeprefix("scikit-image:")
     if name in BENCH:
         bgr = cv2.imread(str(BENCH_DIR / f"{name}.jpg"))
         if bgr is None:

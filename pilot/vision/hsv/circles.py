@@ -9,6 +9,7 @@ colour inside and for rim support (``rim.py``). Figures: bench/vision/HISTORY.md
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import NamedTuple
 
 import cv2
@@ -136,18 +137,24 @@ def inside_share(mask: MatLike, cx: float, cy: float, r: float) -> float:
     return 0.0 if inside is None else float(np.count_nonzero(inside)) / len(inside)
 
 
-def circles(roi: MatLike, mask: MatLike, frame: MatLike, x0: int, y0: int) -> list[Circle]:
+def circles(roi: MatLike, mask: MatLike, frame: MatLike, x0: int, y0: int,
+            go: Callable[[], bool] = lambda: True) -> list[Circle]:
     """The circles in the window at (x0, y0) of ``frame`` (``roi``, its smoothed pixels; ``mask``, its colour
     mask) with the target's colour inside and a rim all round: the circle the rim support fits best (measured on
     the frame: unsmoothed, and not cut by the window's edge). A window with none gives its domed circles instead:
-    from ``COLOUR_FROM`` across, a rim of ``DOMED_RIM``, the middle lit as a ball's."""
+    from ``COLOUR_FROM`` across, a rim of ``DOMED_RIM``, the middle lit as a ball's. ``go``: whether the frame's
+    budget has time left, asked before each vote and each circle's rim (a red-heavy window's look took up to 12 ms
+    past the budget when asked only before it)."""
     r_max = max(mask.shape[:2]) / 2.0
     near = cv2.dilate(mask, _NEAR)  # where the edges vote, in brightness and in colour
     voted = [(c, 0.0) for c in centres(cv2.cvtColor(roi, cv2.COLOR_BGR2GRAY), near, r_max)]
-    voted += [(c, COLOUR_FROM) for c in centres(roi, near, r_max)]  # in colour: counted from COLOUR_FROM across
+    if go():
+        voted += [(c, COLOUR_FROM) for c in centres(roi, near, r_max)]  # in colour: counted from COLOUR_FROM across
     out: list[Circle] = []
     dome: list[Circle] = []
     for (cx, cy, r), least in voted:
+        if not go():
+            break
         inside = inside_share(mask, cx, cy, r)
         if inside < INSIDE:
             continue
@@ -173,7 +180,7 @@ def _objects(found: list[Circle]) -> int:
 
 
 def circle_features(roi: MatLike, hsv: MatLike, mask: MatLike, frame: MatLike, x0: int, y0: int,
-                    colour: ColourMask) -> list[Features]:
+                    colour: ColourMask, go: Callable[[], bool] = lambda: True) -> list[Features]:
     """The circles of a window at (x0, y0) of ``frame`` (``roi``, its smoothed pixels, their HSV and mask), as
     the detector's features: the rim stands in for the arcs, the mask inside for the fill; the colour is the mask's
     inside 0.9 radii (the rim's pixels blend). From ``COLOUR_FROM`` across, isolation is the rim too, counted once: a
@@ -189,7 +196,7 @@ def circle_features(roi: MatLike, hsv: MatLike, mask: MatLike, frame: MatLike, x
     detections, 1 more in the 12,000 (a pink ball, 0.59 -> 0.60). Counting a whole rim as isolation in the rim look
     too found no ball more, and 4 false detections more."""
     out = []
-    found = circles(roi, mask, frame, x0, y0)
+    found = circles(roi, mask, frame, x0, y0, go)
     if _objects(found) > 1:
         return []
     for c in found:

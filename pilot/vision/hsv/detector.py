@@ -176,8 +176,12 @@ class HsvBlobDetector(WindowRefiner):
             if max(bw, bh) * k < SIZE[1]:
                 continue
             x0, y0, roi, hsv, mask = self._blob_window(image, bounds, (x * k, y * k, bw * k, bh * k))
-            out += [f for f in circle_features(roi, hsv, mask, image, x0, y0, self.colour) if is_new(f, out)]
+            out += [f for f in circle_features(roi, hsv, mask, image, x0, y0, self.colour, self._time_left)
+                    if is_new(f, out)]
         return out
+
+    def _time_left(self) -> bool:
+        return not self.budget.out()
 
     def _rim_look(self, found: list[Features]) -> list[Features]:
         """The blobs held down by their arcs or ring measured again with their rim support; each replaces its

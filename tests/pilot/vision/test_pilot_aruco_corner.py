@@ -100,3 +100,16 @@ def test_a_tracked_marker_whose_corner_gets_covered_stays_tracked_whatever_the_b
     covered_now = det.detect(whole)
     assert covered_now.found and not covered_now.predicted and covered_now.confidence == CORNER_SCORE
     assert math.hypot(covered_now.cx - cx, covered_now.cy - cy) < 4.0
+
+
+def test_a_covered_marker_must_read_every_uncovered_cell() -> None:
+    """One code cell read otherwise let 13 of the 4,096 codes of the 12 uncovered bits match: an empty view of the
+    tuning sources read as a marker."""
+    from pilot.vision.aruco_corner import COVERED, matches, reference_cells
+
+    refs = reference_cells(cv2.aruco.getPredefinedDictionary(vi.MARKER_DICT), vi.MARKER_ID)
+    cells = refs[0].copy()
+    cells[:COVERED, :COVERED] = ~cells[:COVERED, :COVERED]  # the covered corner: read as anything
+    assert matches(cells, refs)
+    cells[COVERED + 1, COVERED] = ~cells[COVERED + 1, COVERED]  # one uncovered code cell read otherwise
+    assert not any(matches(np.rot90(cells, k), refs) for k in range(4))

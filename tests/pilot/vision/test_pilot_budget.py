@@ -115,3 +115,44 @@ def test_make_detector_passes_its_clock_to_either_detector() -> None:
     aruco = make_detector(PilotConfig(detector="aruco"), clock=clock).source
     assert isinstance(hsv, HsvBlobDetector) and hsv.budget.clock is clock
     assert isinstance(aruco, ArucoMarkerDetector) and aruco.budget.clock is clock
+
+
+def test_the_circle_look_stops_inside_a_window_when_the_budget_is_spent() -> None:
+    """A red-heavy window's circle look took up to 12 ms past the budget when the budget was asked only before it:
+    it is asked before each vote and each circle's rim."""
+    from pilot_synth import on_surface
+
+    from pilot.vision.hsv.circles import circles
+
+    img = on_surface(12, 0, 40)
+    mask, roi = HsvBlobDetector().mask(img), cv2.medianBlur(img, 3)
+    assert circles(roi, mask, img, 0, 0)  # time left: the ball's circle
+    asked: list[int] = []
+
+    def spent() -> bool:
+        asked.append(1)
+        return False
+
+    assert circles(roi, mask, img, 0, 0, spent) == [] and len(asked) == 2  # no colour vote, no rim read
+
+
+def test_the_edge_cut_measures_no_piece_once_the_budget_is_spent(monkeypatch: pytest.MonkeyPatch) -> None:
+    import pilot.vision.hsv.edges as edges
+    import pilot.vision.hsv.refine as refine
+
+    det = HsvBlobDetector(vision=VisionConfig(budget_ms=2.0), clock=lambda: 0.0)
+    real, cuts, measured = edges.cut_by_edges, [], []
+
+    def cut_then_spent(*args: object, **kw: object) -> object:
+        out = real(*args, **kw)  # type: ignore[arg-type]
+        cuts.append(len(out.pieces))
+        det.budget.exhausted = True  # the time ran out while the window was cut
+        return out
+
+    monkeypatch.setattr(refine, "cut_by_edges", cut_then_spent)
+    img = red_heavy()
+    cv2.rectangle(img, (20, 20), (140, 120), RED, -1)  # a red slab with a ball on it: cut by the edges
+    cv2.circle(img, (80, 70), 20, (20, 10, 120), -1)
+    monkeypatch.setattr(det, "measure", lambda *a, **k: measured.append(1))  # the pieces' measure
+    det._edge_split(img, det.colour.bounds_for(img), [(1.0, np.zeros((1, 1, 2), np.int32), (8, 8, 70, 60))], 2, [])
+    assert cuts and cuts[0] > 0 and not measured
