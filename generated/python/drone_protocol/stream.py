@@ -25,13 +25,11 @@ def _any_of(codes: Iterable[int]) -> bytes:
 _PAIR = b"|".join(re.escape(bytes([c])) + _any_of(d) for c, d in BY_BYTES.items())
 # Frame-shaped bytes: a category, one of its directions, digits. Splitting the data at them gives
 # the garbage before each, the frames and the rest at C speed; the frames are then checked.
-_SHAPE = re.compile(b"(?:" + _PAIR + b")" + b"[0-9]" * (FRAME_LENGTH - 2))
-_SPLIT = re.compile(b"(" + _SHAPE.pattern + b")")
+_SHAPE = re.compile(b"((?:" + _PAIR + b")" + b"[0-9]" * (FRAME_LENGTH - 2) + b")")
 # At each category byte, an empty match where one of its directions follows, the byte itself where none does:
 # garbage is counted by kind at C speed, whatever its length and the number of categories.
 _STARTS = b"|".join(re.escape(bytes([c])) + b"(?=" + _any_of(d) + b")" for c, d in BY_BYTES.items())
 _KINDS = re.compile(_STARTS + b"|(" + _any_of(BY_BYTES) + b")")
-_PAIRS = re.compile(_STARTS)
 _BAD_CATEGORY, _BAD_DIRECTION = ErrorKind.BAD_CATEGORY, ErrorKind.BAD_DIRECTION
 # Pending lengths at which a byte is a value digit that completes nothing, and the one at which a byte
 # completes the wire frame.
@@ -129,7 +127,7 @@ class StreamDecoder:
     def _scan(self, data: bytes) -> list[Command]:
         """The frames in `data` (pending bytes first), the leftmost first: one error per start position where none
         starts; the valid start of a frame at the end of the data waits for the rest."""
-        parts = _SPLIT.split(data)  # garbage, frame-shaped bytes, garbage, ..., the rest: all at C speed
+        parts = _SHAPE.split(data)  # garbage, frame-shaped bytes, garbage, ..., the rest: all at C speed
         frames = parts[1::2]
         found = list(map(DECODED.get, frames))
         kept = complete(frames, found) if None in found else len(frames)
@@ -219,8 +217,9 @@ class StreamDecoder:
         """Count the error at each start in data[start:end] where a category and one of its directions are not
         followed by a frame: problem() says what is wrong."""
         errors = self._errors
-        for pair in _PAIRS.finditer(data, start, end + 1):
-            errors[_kind(data, pair.start())] += 1
+        for start_of in _KINDS.finditer(data, start, end + 1):
+            if start_of.group(1) is None:  # an empty match: a category and one of its directions
+                errors[_kind(data, start_of.start())] += 1
 
 
 def _kind(data: bytes, start: int) -> ErrorKind:
