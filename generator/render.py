@@ -82,6 +82,9 @@ def _environment(target: Target) -> jinja2.Environment:
         # own file names, which key the cache.
         finalize=filters.html_text if target.escape == "html" else None,
         bytecode_cache=_template_cache(),
+        # No constant folding when compiling: it cost about a sixth of an uncached run's compiling, and rendering
+        # folds the same constants at no measurable cost.
+        optimized=False,
     )
     env.filters.update(filters.ALL)
     return env

@@ -134,6 +134,33 @@ def valid(frame: bytes) -> Command | None:
     return None
 
 
+def complete(frames: list[bytes], commands: list[Command | None]) -> int:
+    """Fill in the None entries of `commands` (DECODED's answers for `frames`, frame-shaped bytes of WIRE_LENGTH:
+    digits where the value goes) with valid()'s, written out: a call per frame cost more than its body. Return the
+    index of the first frame that is not valid, or len(frames)."""
+    k = commands.index(None)
+    try:
+        while True:
+            frame = frames[k]
+            command = DECODED.get(frame)  # a repeat of a frame decoded earlier in this data
+            if command is None:
+                fields = _FIELDS[frame[0]][frame[1]]
+                if fields is None:
+                    return k
+                value = int(frame[2:FRAME_LENGTH])
+                category, direction, name, minimum, maximum = fields
+                if not minimum <= value <= maximum:
+                    return k
+                command = _new(Command, (category, direction, value, name))
+                if len(DECODED) >= _DECODED_MAX:
+                    DECODED.clear()
+                DECODED[frame] = command
+            commands[k] = command
+            k = commands.index(None, k + 1)
+    except ValueError:  # no None left
+        return len(frames)
+
+
 def problem(data: bytes, start: int, length: int) -> tuple[ErrorKind, int] | None:
     """The first problem of the `length` bytes of `data` from `start`, as the start of a wire frame: the error
     kind and its position in the frame; None when they can start a valid frame. The range is checked once the

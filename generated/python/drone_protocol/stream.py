@@ -7,20 +7,30 @@ from __future__ import annotations
 
 import re
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from types import MappingProxyType
 
-from .codec import BY_BYTES, DECODED, BytesLike, Command, problem, valid
+from .codec import BY_BYTES, DECODED, BytesLike, Command, complete, problem, valid
 from .errors import ClockError
 from .tables import FRAME_LENGTH, INTER_BYTE_TIMEOUT_MS, WIRE_LENGTH, ErrorKind
 
-# Any byte that may start a frame; a run of other bytes is one bad_category error each, counted at C speed.
-_CATEGORY_BYTE = re.compile(b"[" + b"".join(re.escape(bytes([c])) for c in BY_BYTES) + b"]")
-# Bytes shaped like a frame (a category, a direction of any category, digits): found at C speed, then checked.
-_FRAME_SHAPE = re.compile(
-    b"[" + b"".join(re.escape(bytes([c])) for c in BY_BYTES) + b"]"
-    + b"[" + b"".join(re.escape(bytes([d])) for c in BY_BYTES.values() for d in sorted(c)) + b"]"
-    + b"[0-9]" * (FRAME_LENGTH - 2))
+
+def _any_of(codes: Iterable[int]) -> bytes:
+    return b"[" + b"".join(re.escape(bytes([c])) for c in sorted(codes)) + b"]"
+
+
+
+# One alternative per category, each starting with its byte: the regular expression engine skips the bytes that
+# start no frame at C speed, and tries the alternatives only where one may start.
+_PAIR = b"|".join(re.escape(bytes([c])) + _any_of(d) for c, d in BY_BYTES.items())
+# Frame-shaped bytes: a category, one of its directions, digits. Splitting the data at them gives
+# the garbage before each, the frames and the rest at C speed; the frames are then checked.
+_SHAPE = re.compile(b"((?:" + _PAIR + b")" + b"[0-9]" * (FRAME_LENGTH - 2) + b")")
+# At each category byte, an empty match where one of its directions follows, the byte itself where none does:
+# garbage is counted by kind at C speed, whatever its length and the number of categories.
+_STARTS = b"|".join(re.escape(bytes([c])) + b"(?=" + _any_of(d) + b")" for c, d in BY_BYTES.items())
+_KINDS = re.compile(_STARTS + b"|(" + _any_of(BY_BYTES) + b")")
+_BAD_CATEGORY, _BAD_DIRECTION = ErrorKind.BAD_CATEGORY, ErrorKind.BAD_DIRECTION
 # Pending lengths at which a byte is a value digit that completes nothing, and the one at which a byte
 # completes the wire frame.
 _DIGITS_END = FRAME_LENGTH if WIRE_LENGTH > FRAME_LENGTH else FRAME_LENGTH - 1
@@ -115,49 +125,108 @@ class StreamDecoder:
         return self._pending
 
     def _scan(self, data: bytes) -> list[Command]:
-        out: list[Command] = []
-        i, n = 0, len(data)
-        while i < n:
-            if n - i >= WIRE_LENGTH:
-                frame = data[i:i + WIRE_LENGTH]
-                command = DECODED.get(frame)
-                if command is None and data[i] in BY_BYTES:
-                    command = valid(frame)
-                if command is not None:
-                    out.append(command)
-                    i += WIRE_LENGTH
-                    continue
-            # No frame starts at i: everything up to the next frame-shaped bytes is garbage, counted per start.
-            shaped = _FRAME_SHAPE.search(data, i)
-            end = shaped.start() if shaped is not None else n
-            if end == i:  # frame-shaped, but out of range
-                found = problem(data, i, WIRE_LENGTH)
-                self._errors[found[0] if found is not None else ErrorKind.BAD_DIRECTION] += 1
-                i += 1
-                continue
-            i = self._garbage(data, i, end)
-            if i < end:
-                break  # the valid start of a frame at the end of the data: wait for the rest
-        self._pending = data[i:]
+        """The frames in `data` (pending bytes first), the leftmost first: one error per start position where none
+        starts; the valid start of a frame at the end of the data waits for the rest."""
+        parts = _SHAPE.split(data)  # garbage, frame-shaped bytes, garbage, ..., the rest: all at C speed
+        frames = parts[1::2]
+        found = list(map(DECODED.get, frames))
+        kept = complete(frames, found) if None in found else len(frames)
+        commands = list(filter(None, found if kept == len(frames) else found[:kept]))  # no None left before kept
+        garbage = parts[0:kept * 2 + 1:2]  # before each frame kept, then the rest (or what precedes an invalid one)
+        last = garbage.pop()
+        if not any(garbage):  # no garbage between the frames kept
+            i = kept * WIRE_LENGTH
+        else:  # _count() of each piece, written out: the call cost more than its body
+            i = bad_category = bad_direction = 0
+            kinds = _KINDS.findall
+            for before in garbage:
+                if before:
+                    end = i + len(before)
+                    starts = kinds(data, i, end + 1)
+                    categories = len(starts) - 1  # the last is the frame's category, its direction out of sight
+                    pairs = starts.count(b"")
+                    bad_category += end - i - categories
+                    bad_direction += categories - pairs
+                    if pairs:
+                        self._pairs(data, i, end)
+                    i = end
+                i += WIRE_LENGTH
+            errors = self._errors
+            errors[_BAD_CATEGORY] += bad_category
+            errors[_BAD_DIRECTION] += bad_direction
+        if kept < len(frames):  # frame-shaped, but out of range: one error at its start, then byte by byte
+            if last:
+                self._count(data, i, i + len(last))
+                i += len(last)
+            self._errors[_kind(data, i)] += 1
+            return self._search(data, i + 1, commands)
+        if last:
+            return self._rest(data, i, commands)
+        self._pending = b""
+        return commands
+
+    def _search(self, data: bytes, i: int, out: list[Command]) -> list[Command]:
+        """_scan() from i, one frame-shaped position at a time: after a frame-shaped one that is not valid, the
+        next may start inside it."""
+        errors = self._errors
+        while True:
+            shaped = _SHAPE.search(data, i)
+            if shaped is None:
+                return self._rest(data, i, out)
+            start = shaped.start()
+            if start > i:
+                self._count(data, i, start)
+            frame = data[start:start + WIRE_LENGTH]
+            command = DECODED.get(frame) or valid(frame)
+            if command is None:
+                errors[_kind(data, start)] += 1
+                i = start + 1
+            else:
+                out.append(command)
+                i = start + WIRE_LENGTH
+
+    def _rest(self, data: bytes, i: int, out: list[Command]) -> list[Command]:
+        """No frame from i on: each start is garbage, up to the valid start of a frame in the last bytes."""
+        n = len(data)
+        tail = max(i, n - WIRE_LENGTH + 1)
+        if tail > i:
+            self._count(data, i, tail)
+        errors = self._errors
+        for at in range(tail, n):
+            found = problem(data, at, n - at)
+            if found is None:
+                self._pending = data[at:]
+                return out
+            errors[found[0]] += 1
+        self._pending = b""
         return out
 
-    def _garbage(self, data: bytes, start: int, end: int) -> int:
-        """Count one error per start position in data[start:end], where no whole frame starts; return where a
-        frame may still start (only in the data's last bytes), or `end`."""
+    def _count(self, data: bytes, start: int, end: int) -> None:
+        """Count one error per start position in data[start:end], where no frame starts, by kind (data[end]
+        exists: a direction is looked for after each category byte)."""
         errors = self._errors
-        i = start
-        while i < end:
-            category = _CATEGORY_BYTE.search(data, i, end)
-            at = category.start() if category is not None else end
-            errors[ErrorKind.BAD_CATEGORY] += at - i
-            if category is None:
-                return end
-            found = problem(data, at, min(WIRE_LENGTH, len(data) - at))
-            if found is None:
-                return at
-            errors[found[0]] += 1
-            i = at + 1
-        return end
+        kinds = _KINDS.findall(data, start, end + 1)
+        pairs = kinds.count(b"")
+        categories = len(kinds) - (data[end] in BY_BYTES)  # data[end] is matched, its direction out of sight
+        errors[_BAD_CATEGORY] += end - start - categories
+        errors[_BAD_DIRECTION] += categories - pairs
+        if pairs:
+            self._pairs(data, start, end)
+
+    def _pairs(self, data: bytes, start: int, end: int) -> None:
+        """Count the error at each start in data[start:end] where a category and one of its directions are not
+        followed by a frame: problem() says what is wrong."""
+        errors = self._errors
+        for start_of in _KINDS.finditer(data, start, end + 1):
+            if start_of.group(1) is None:  # an empty match: a category and one of its directions
+                errors[_kind(data, start_of.start())] += 1
+
+
+def _kind(data: bytes, start: int) -> ErrorKind:
+    """The error at `start`, where WIRE_LENGTH bytes start no valid frame (problem() always finds one there)."""
+    found = problem(data, start, WIRE_LENGTH)
+    return found[0] if found is not None else ErrorKind.BAD_DIRECTION
+
 
 def _checked(data: object, now: object) -> tuple[bytes, float]:
     """feed()'s arguments as bytes and a float, or a TypeError naming the wrong one."""

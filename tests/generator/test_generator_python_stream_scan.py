@@ -1,0 +1,101 @@
+"""The generated Python StreamDecoder's chunk scan (split at frame-shaped bytes, garbage counted by kind with
+compiled patterns) against the plainest reading of the rule: at each position a valid frame is taken whole, any other
+start is one error of the kind problem() names, and the valid start of a frame at the end waits for the rest."""
+
+from __future__ import annotations
+
+import random
+
+import drone_protocol as dp
+import pytest
+from drone_protocol import stream as dp_stream
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+CODES = sorted({*dp.codec.BY_BYTES, *(d for t in dp.codec.BY_BYTES.values() for d in t), *b"0123456789", 0xFF})
+
+
+def reference(data: bytes) -> tuple[list[dp.Command], dict[dp.ErrorKind, int], bytes]:
+    """One position at a time, with the codec's own valid() and problem()."""
+    out: list[dp.Command] = []
+    errors = dict.fromkeys(dp.ErrorKind, 0)
+    i, n = 0, len(data)
+    while i < n:
+        if n - i >= dp.WIRE_LENGTH:
+            command = dp.codec.valid(data[i:i + dp.WIRE_LENGTH])
+            if command is not None:
+                out.append(command)
+                i += dp.WIRE_LENGTH
+                continue
+        found = dp.codec.problem(data, i, min(dp.WIRE_LENGTH, n - i))
+        if found is None:
+            return out, errors, data[i:]
+        errors[found[0]] += 1
+        i += 1
+    return out, errors, b""
+
+
+def scanned(data: bytes) -> tuple[list[dp.Command], dict[dp.ErrorKind, int], bytes]:
+    decoder = dp.StreamDecoder()
+    out = decoder.feed(data, 0.0)
+    return out, dict(decoder.errors), decoder.pending
+
+
+def piece(rng: random.Random) -> bytes:
+    spec = rng.choice(list(dp.COMMANDS.values()))
+    roll = rng.random()
+    if roll < 0.4:
+        return dp.command_frame(spec.name, rng.randint(spec.minimum, spec.maximum))
+    if roll < 0.5:  # frame-shaped, in range or not
+        return spec.prefix + b"%04d" % rng.randint(0, 9999)
+    if roll < 0.6:
+        return dp.command_frame(spec.name, spec.maximum)[:rng.randint(1, dp.WIRE_LENGTH - 1)]
+    return bytes(rng.choice(CODES) for _ in range(rng.randint(1, 8)))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_scan_finds_what_one_position_at_a_time_finds(seed: int) -> None:
+    rng = random.Random(seed)
+    for _ in range(300):
+        data = b"".join(piece(rng) for _ in range(rng.randint(0, 40)))
+        if rng.random() < 0.5:
+            dp.codec.DECODED.clear()
+        assert scanned(data) == reference(data), data
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.binary(max_size=60))
+def test_the_scan_agrees_with_the_reference_on_any_bytes(data: bytes) -> None:
+    assert scanned(data) == reference(data)
+
+
+def test_an_out_of_range_frame_overlapping_a_valid_one_loses_neither() -> None:
+    """After frame-shaped bytes that are not valid the next frame may start inside them: "ml0000" (out of range)
+    holds "l0000" plus one byte, a laser toggle when it is a digit."""
+    toggle = dp.command_frame(dp.CommandName.LASER_TOGGLE)
+    data = b"m" + toggle + dp.command_frame(dp.CommandName.ARM)
+    assert data[:dp.WIRE_LENGTH] == b"ml0000" and dp.codec.valid(data[:dp.WIRE_LENGTH]) is None
+    assert scanned(data) == reference(data)
+    assert [c.name for c in scanned(data)[0]] == [dp.CommandName.LASER_TOGGLE, dp.CommandName.ARM]
+
+
+def test_category_bytes_in_garbage_are_counted_without_problem(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A category byte followed by none of its directions is a bad_direction counted at C speed: problem() runs only
+    where a category and one of its directions start no frame, so the garbage path does not slow down with more
+    categories."""
+    calls = []
+    original = dp.codec.problem
+
+    def counting(data: bytes, start: int, length: int) -> tuple[dp.ErrorKind, int] | None:
+        calls.append(start)
+        return original(data, start, length)
+
+    monkeypatch.setattr(dp_stream, "problem", counting)
+    category = next(iter(dp.codec.BY_BYTES))
+    not_direction = next(b for b in range(0x80, 0x100) if b not in dp.codec.BY_BYTES[category])
+    garbage = bytes([category, not_direction]) * 50
+    data = garbage + dp.command_frame(dp.CommandName.ARM)
+    out, errors, pending = scanned(data)
+    assert [c.name for c in out] == [dp.CommandName.ARM] and pending == b""
+    assert errors[dp.ErrorKind.BAD_DIRECTION] == 50 and errors[dp.ErrorKind.BAD_CATEGORY] == 50
+    assert calls == []
