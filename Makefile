@@ -69,7 +69,11 @@ pythons:
 pytest: deps pythons
 	$(PY) -m pytest -q -n 2 --dist loadgroup --no-loadscope-reorder tests
 
-test: deps check-generated lint typecheck pytest fuzz-smoke
+# After pytest, the native targets' own tests (fuzz-smoke here; targets.mk and typescript.mk add theirs to TEST_TAIL)
+# run two at a time: each is one process for most of its time, and they build into folders of their own.
+TEST_TAIL := fuzz-smoke
+test: deps check-generated lint typecheck pytest
+	@$(MAKE) --no-print-directory -j2 --output-sync=target $(TEST_TAIL)
 
 demo: deps generate
 	$(PY) -m generator.demo

@@ -22,7 +22,7 @@ C_FUZZ_LONG_SECONDS ?= 300
 
 .PHONY: targets-test rust-test c-test c-fuzz-smoke c-fuzz cargo-available
 
-test: targets-test
+TEST_TAIL += targets-test
 
 targets-test: rust-test c-test c-fuzz-smoke
 

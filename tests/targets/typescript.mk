@@ -26,7 +26,7 @@ TS_ENV = DRONE_PROTOCOL_TS_BUILD=$(abspath $(TS_BUILD)) DRONE_PROTOCOL_PYTHON=$(
 
 .PHONY: typescript typescript-test typescript-console bench-typescript
 
-test: typescript-test
+TEST_TAIL += typescript-test
 
 # Node and npm: Debian's when missing (a machine with NodeSource's node already has both).
 $(TS_TOOLS): $(TS_TOOLS_DIR)/package.json $(TS_TOOLS_DIR)/package-lock.json
