@@ -138,7 +138,7 @@ class Controller(ControllerCore):
 
     def _trimmed(self, frame: bytes | None, det: Detection | None) -> bytes | None:
         """Learn the drift from the target's sightings and lean against it (``trim.py``)."""
-        seen = self.state in LOCKED and det is not None and self._found(det) and not det.predicted
+        seen = self.state in FLYING and det is not None and self._found(det) and not det.predicted
         sighting = (det.range_m, self._bearing(det)) if seen and det is not None else None
         # the closing speed is the drift's only where no pitch of the pilot's own is still carrying the drone on
         if self.sticks.pitch(self._now()) or self.state not in HELD:

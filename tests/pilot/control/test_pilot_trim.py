@@ -4,12 +4,15 @@ speed."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import drone_protocol as dp
 import pytest
+from controller_rig import CFG, name, seen, to_state
 
 from pilot.control.approach import Lead
+from pilot.control.controller import State
 from pilot.control.pulses import StickModel
 from pilot.control.trim import SETTLE_MS, Drift, DriftHold, TrimSticks
 
@@ -117,3 +120,16 @@ def test_the_controllers_own_pitch_is_not_paid_back_after_it() -> None:
     for k in range(10):  # half a second of approach, no trim wanted
         sticks.shape(dp.move_forward(1600), 50 * k, 0.0, 0.0, 0.0)
     assert sticks.shape(dp.hold_altitude(), 500, 0.0, 0.0, 0.0) == dp.hold_altitude()
+
+
+def test_aiming_at_a_target_that_slides_left_leans_left_in_the_holds() -> None:
+    """AIM with the target sliding left in the frame (the drone drifting right): the controller learns a trim to
+    the left and its holds carry it as roll; a still target teaches nothing."""
+    c, rig = to_state(State.AIM, dataclasses.replace(CFG, aim_frames=1000))
+    assert c.drift.drift.right == 0.0
+    frames = [rig.tick(seen(ex=0.0, size=0.2)) for _ in range(40)]
+    assert abs(c.drift.drift.right) < 0.01 and all(name(f) != "move_left" for f in frames if f is not None)
+    c, rig = to_state(State.AIM, dataclasses.replace(CFG, aim_frames=1000))
+    frames = [rig.tick(seen(ex=0.02 - 0.002 * k, size=0.2)) for k in range(40)]
+    assert c.drift.drift.right < -0.02
+    assert any(f is not None and name(f) == "move_left" for f in frames)
