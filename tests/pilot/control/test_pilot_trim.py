@@ -10,6 +10,7 @@ import math
 import drone_protocol as dp
 import pytest
 from controller_rig import CFG, name, seen, to_state
+from test_pilot_approach import size_at
 
 from pilot.control.approach import Lead
 from pilot.control.controller import State
@@ -133,3 +134,13 @@ def test_aiming_at_a_target_that_slides_left_leans_left_in_the_holds() -> None:
     frames = [rig.tick(seen(ex=0.02 - 0.002 * k, size=0.2)) for k in range(40)]
     assert c.drift.drift.right < -0.02
     assert any(f is not None and name(f) == "move_left" for f in frames)
+
+
+def test_a_closing_speed_right_after_the_pilots_own_pitch_teaches_no_forward_trim() -> None:
+    """AIM brakes a drone still closing in from its approach: that speed is the approach's, not the drift's."""
+    c, rig = to_state(State.AIM, dataclasses.replace(CFG, aim_frames=1000))
+    r = 1.4
+    for _ in range(20):
+        r -= 0.03  # 0.6 m/s closer: the range hold brakes
+        rig.tick(seen(size=size_at(r)))
+    assert any(name(f) == "move_backward" for f in rig.sent) and c.drift.drift.forward == 0.0
