@@ -9,8 +9,7 @@ import math
 
 import drone_protocol as dp
 import pytest
-from controller_rig import CFG, name, seen, to_state
-from test_pilot_approach import size_at
+from controller_rig import CFG, name, seen, size_at, to_state
 
 from pilot.control.approach import Lead
 from pilot.control.controller import State
