@@ -75,8 +75,9 @@ def held_out(args: argparse.Namespace) -> int:
     """The strict campaign on held-out seeds (RESULTS-held-out.md), or its HSV flights with another speed step
     (RESULTS-step<N>.md, compared flight by flight with the held-out log)."""
     detectors = ("hsv",) if args.step_us else (args.detector,) if args.detector else ("hsv", "aruco")
-    name = (f"step{args.step_us}" if args.step_us else "held-out") + (f"-from{args.first_seed}" if args.first_seed
-                                                                       else "")
+    name = ((f"step{args.step_us}" if args.step_us else "held-out") + (f"-from{args.first_seed}" if args.first_seed
+                                                                        else "")
+            + (f"-{args.detector}" if args.detector and not args.step_us else ""))
     log = LOG.with_name(f"{name}.jsonl")
     t0 = time.perf_counter()
     executable = args.virtual_drone

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Sequence
 
 
 class ClosingSpeed:
@@ -36,16 +37,23 @@ class ClosingSpeed:
     @property
     def closing(self) -> float | None:
         """m/s towards the target (negative: receding); None until enough samples."""
-        n = len(self._samples)
-        if n < self.min_samples:
+        if len(self._samples) < self.min_samples:
             return None
-        mt = sum(t for t, _ in self._samples) / n
-        mr = sum(r for _, r in self._samples) / n
-        var = sum((t - mt) ** 2 for t, _ in self._samples)
-        if var <= 0.0:
-            return None
-        slope = sum((t - mt) * (r - mr) for t, r in self._samples) / var
-        return -slope
+        rate = slope(self._samples)
+        return None if rate is None else -rate
+
+
+def slope(samples: Sequence[tuple[float, float]]) -> float | None:
+    """The least-squares slope of (t, value) samples, value per second (None: no spread in time)."""
+    n = len(samples)
+    if n < 2:
+        return None
+    mt = sum(t for t, _ in samples) / n
+    mv = sum(v for _, v in samples) / n
+    var = sum((t - mt) ** 2 for t, _ in samples)
+    if var <= 0.0:
+        return None
+    return sum((t - mt) * (v - mv) for t, v in samples) / var
 
 
 def allowed_speed(remaining_m: float, brake_mps2: float, top_mps: float) -> float:
@@ -92,3 +100,27 @@ class Lean:
         """``pitch_steps``: the pitch stick held during ``dt`` (its lean follows whatever the state: no reset)."""
         if dt > 0.0:
             self.deg += (self.deg_per_step * pitch_steps - self.deg) * (1.0 - math.exp(-dt / self.lag_s))
+
+
+class Lead:
+    """What the pitch commands of the last ``lag_s`` added to the speed, which the closing-speed fit cannot show
+    yet: the fit describes the middle of its window, and each frame reaches the pilot up to 120 ms after its
+    exposure. Added to the fit, it keeps a brake from running on past the stop (and the drone flying backwards)."""
+
+    def __init__(self, accel_per_step: float, lag_s: float = 0.3) -> None:
+        self.accel_per_step = accel_per_step
+        self.lag_s = lag_s
+        self._steps: deque[tuple[float, float]] = deque()  # (dt, pitch steps held during it), newest last
+
+    def advance(self, pitch_steps: float, dt: float) -> None:
+        if dt <= 0.0:
+            return
+        self._steps.append((dt, pitch_steps))
+        total = sum(d for d, _ in self._steps)
+        while self._steps and total - self._steps[0][0] >= self.lag_s:
+            total -= self._steps.popleft()[0]
+
+    @property
+    def speed(self) -> float:
+        """m/s forward the recent pitch commands added."""
+        return self.accel_per_step * sum(d * s for d, s in self._steps)

@@ -21,10 +21,11 @@ import drone_protocol as dp
 from ..common.config import ControllerConfig
 from ..vision.detection import Detection
 from ..vision.gating import Gate
-from .approach import ClosingSpeed, Lean, Momentum, allowed_speed
+from .approach import ClosingSpeed, Lead, Lean, Momentum, allowed_speed
 from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, turn_towards
 from .response import TurnResponse, turn_sense
 from .sticks import HeldSticks
+from .trim import DriftHold
 from .vertical import Height, SeenFrom
 
 __all__ = ["FLYING", "LOCKED", "Controller", "State", "Transition"]
@@ -34,6 +35,9 @@ VIEW_EDGE = 0.9  # a brake's lean keeps the target's lower edge above this share
 MIN_BRAKE = 0.4  # control steps: the gentlest brake, whatever the view allows
 RETURN_TOL_M = 0.05  # a search's return to the height the target was seen from ends this close to it
 RETURN_MAX_MS = 3000  # ... or this long after the search began
+TRIMMED = FLYING - {State.TAKEOFF}  # the states that lean against the drift (the take-off's climb takes every frame)
+HELD = frozenset({State.ACQUIRE, State.AIM, State.FIRE})  # no approach commanded: the closing speed is drift
+PITCH_CALM_MS = 1500  # ... once the pilot's own pitch has been neutral this long (a brake's lean and speed gone)
 
 
 def _brake_steps(speed: float) -> float:
@@ -55,6 +59,7 @@ class Controller(ControllerCore):
         # drone flies on, and vision's speed then drops to zero just before the loss
         self.reckoned = Momentum(self.cfg.pitch_accel_mps2)
         self.lean = Lean(self.cfg.pitch_accel_mps2)
+        self.lead = Lead(self.cfg.pitch_accel_mps2)
         self.height = Height(self.cfg.climb_mps_per_step)
         self.seen_from = SeenFrom()
         self._return_m: float | None = None  # a search first goes back to this height
@@ -64,16 +69,23 @@ class Controller(ControllerCore):
         self._last_ms = self._now()
         self._brake_until_ms = 0  # target lost while closing in: brake this long before searching
         self._brake_speed = 0.0
+        self.drift = DriftHold(self.pulses, self.cfg.unit_lean_deg)
+        self._pitch_calm_ms = self._now()
 
     def _hold_range(self, det: Detection) -> bytes | None:
         """Near the target nothing holds position but the pilot: brake a closing speed, nudge forward against a
         receding one; None while the range holds (within ``HOLD_MPS``)."""
-        closing = self.closing.closing
+        closing = self._closing_now()
         if closing is None or abs(closing) <= HOLD_MPS:
             return None
         if closing > 0.0:
             return self._brake(closing, det)
         return self._emit(dp.move_forward(self._speed(dp.CommandName.MOVE_FORWARD, min(1.2, 0.6 - closing))))
+
+    def _closing_now(self) -> float | None:
+        """The closing speed's fit, plus what the pitch commands since the frames it rests on added (``Lead``)."""
+        closing = self.closing.closing
+        return None if closing is None else closing + self.lead.speed
 
     def _brake(self, speed: float, det: Detection | None = None) -> bytes:
         """Pitch back against a closing speed (``_brake_steps``), with the target in view no harder than keeps it in
@@ -98,6 +110,7 @@ class Controller(ControllerCore):
         self.momentum.advance(held, dt)
         self.reckoned.advance(held, dt)
         self.lean.advance(held, dt)
+        self.lead.advance(held, dt)
         self.height.advance(self.sticks.throttle(now), dt)
         self._last_ms = now
         if det is not None and det.found and self.state in LOCKED:
@@ -118,9 +131,24 @@ class Controller(ControllerCore):
         frame = self._decide_frame(det)
         if det is not None and self.gate.acquired() and not det.predicted:
             self.seen_from.saw(self.height.m)
-        self.sticks.sent(frame, self._now())
+        self.sticks.sent(frame, self._now())  # dead reckoning: the controller's own commands, not the trim
+        frame = self._trimmed(frame, det)
         self._turned = turn_sense(frame, self.pulses)
         return frame
+
+    def _trimmed(self, frame: bytes | None, det: Detection | None) -> bytes | None:
+        """Learn the drift from the target's sightings and lean against it (``trim.py``)."""
+        seen = self.state in FLYING and det is not None and self._found(det) and not det.predicted
+        sighting = (det.range_m, self._bearing(det)) if seen and det is not None else None
+        # the closing speed is the drift's only where no pitch of the pilot's own is still carrying the drone on
+        if self.sticks.pitch(self._now()) or self.state not in HELD:
+            self._pitch_calm_ms = self._now()
+        calm = self._now() - self._pitch_calm_ms >= PITCH_CALM_MS
+        closing = self.closing.closing if calm else None
+        shaped = self.drift.step(frame, self._now(), sighting, closing, self.state in TRIMMED)
+        if shaped is not frame and shaped is not None:
+            self.last_command = shaped
+        return shaped
 
     def _decide_frame(self, det: Detection | None) -> bytes | None:
         # -- vision gate (issue 12): a bad frame holds (laser off), too many in a row land ------------
@@ -260,7 +288,7 @@ class Controller(ControllerCore):
         if size >= cfg.approach_size:  # close enough whatever else is off: AIM centres it with the servos
             self._go(State.AIM, f"close enough (size {size:.3f})")
             return self._on_aim(det)
-        closing, allowed = self.closing.closing, cfg.approach_speed_mps
+        closing, allowed = self._closing_now(), cfg.approach_speed_mps
         if closing is None:  # too few consistent ranges yet: the speed its own pitch commands gave it
             closing = self.momentum.speed
         if det.range_m > 0.0:

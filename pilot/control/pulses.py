@@ -148,6 +148,16 @@ class StickModel:
         """The pulse offset (µs from the median) of one control step on ``channel``, above (up) or below it."""
         return self._unit_us[(channel, up)]
 
+    def lean_offset_us(self, channel: dp.ChannelName, lean_deg: float) -> int:
+        """The pulse offset (µs from the median, the sign of ``lean_deg``) that asks for a roll or pitch lean of
+        ``lean_deg`` past the dead zone, however small: right or forward positive, as the movement commands."""
+        if lean_deg == 0.0:
+            return 0
+        stick, up = self.sticks[channel], lean_deg > 0.0
+        angle = ANGLE_RANGE * abs(lean_deg) * 100.0 / self.params["ANGLE_MAX"]
+        from_trim = (1.0 if up else -1.0) * stick.offset_for_angle(angle, up)
+        return round(stick.trim + from_trim - dp.CHANNELS[channel].median)
+
     def steps(self, channel: dp.ChannelName, offset_us: float) -> float:
         """A pulse offset from the median as control steps (its sign kept)."""
         unit = self.unit_us(channel, offset_us >= 0)

@@ -29,6 +29,8 @@ def _read_every_name() -> None:
         dp.parse_reply, dp.query_status, dp.servo_down, dp.servo_left, dp.servo_reset, dp.servo_right, dp.servo_up,
         dp.turn_left, dp.turn_right, dp.COMMANDS.values, dp.CommandSpec, dp.FAILSAFE_THROTTLE_US,
         dp.ReplyKind.ACCEPTED, dp.SERVOS.values, dp.encode,
+        dp.CommandName.MOVE_LEFT, dp.CommandName.MOVE_RIGHT, dp.CommandName.SERVO_LEFT, dp.CommandName.SERVO_RIGHT,
+        dp.CommandName.SERVO_RESET, dp.command_frame,
     )
 
 

@@ -36,6 +36,15 @@ def seen(ex: float = 0.0, ey: float = 0.0, size: float = 0.05, confidence: float
 MISS = Detection(False, width=W, height=H)
 
 
+def size_at(range_m: float) -> float:
+    """The relative apparent size of the 0.3 m ball at ``range_m`` (inverse of range_of)."""
+    lo, hi = 1.0, 400.0
+    for _ in range(60):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if range_of(mid, 0.3, W, CFG.horizontal_fov_deg) > range_m else (lo, mid)
+    return lo / W
+
+
 def name(frame: bytes | None) -> str:
     assert frame is not None, "expected a command"
     return dp.decode(frame).name

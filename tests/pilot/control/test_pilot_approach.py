@@ -8,23 +8,11 @@ import math
 
 import drone_protocol as dp
 import pytest
-from controller_rig import CFG, MISS, Rig, name, seen, st, to_state
+from controller_rig import CFG, MISS, Rig, name, seen, size_at, st, to_state
 
 from pilot.control.approach import ClosingSpeed, Lean, allowed_speed
 from pilot.control.controller import MIN_BRAKE, Controller, State
 from pilot.control.pulses import StickModel
-from pilot.vision.detection import range_of
-
-W = 320
-
-
-def size_at(range_m: float) -> float:
-    """The relative apparent size of the 0.3 m ball at ``range_m`` (inverse of range_of)."""
-    lo, hi = 1.0, 400.0
-    for _ in range(60):
-        mid = (lo + hi) / 2
-        lo, hi = (mid, hi) if range_of(mid, 0.3, W, CFG.horizontal_fov_deg) > range_m else (lo, mid)
-    return lo / W
 
 
 def test_closing_speed_is_the_slope_of_the_ranges() -> None:

@@ -8,8 +8,9 @@ fire time, the fire completed, landed and disarmed, nothing else lit, no wall to
 rate itself).
 
 These fly the ideal world (``ideal=True``): in the randomised world, on by default since the thirty-third session,
-the pilot does not yet cope with the airframe's trim drift (no position hold, no drift estimate) and these flights
-fail by the strict score; bench/flight/HISTORY.md has the figures."""
+the pilot learns the airframe's trim drift from the target (pilot/control/trim.py) but 6 of these 10 HSV flights
+still fail by the strict score (wall touches before the drift is learnt, stays broken by the drift while firing);
+bench/flight/HISTORY.md has the figures."""
 
 from __future__ import annotations
 
