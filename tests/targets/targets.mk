@@ -11,7 +11,8 @@
 # Cargo builds into build/rust/target, offline, against the committed Cargo.lock (the crate has no dependencies).
 
 TARGETS_BUILD := build/targets
-CARGO_RUN := cd generated/rust && CARGO_TARGET_DIR=$(CURDIR)/build/rust/target cargo
+# no MAKEFLAGS: a `make -j` above would hand cargo a jobserver whose descriptors this recipe line does not get
+CARGO_RUN := cd generated/rust && MAKEFLAGS= MFLAGS= CARGO_TARGET_DIR=$(CURDIR)/build/rust/target cargo
 CARGO_FLAGS := --locked --offline
 RUST_BARE_METAL ?= thumbv7em-none-eabihf
 C_DIR := generated/c
