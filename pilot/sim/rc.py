@@ -12,7 +12,6 @@ with a dead zone; the throttle is 0..1000 above its minimum plus a dead zone; a 
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,6 +21,7 @@ import drone_protocol as dp
 import yaml
 
 from ..common.errors import ConfigError
+from ..common.ranges import within
 from .randomise import Effects
 
 HERE = Path(__file__).resolve().parent
@@ -182,6 +182,6 @@ def _check(values: Mapping[str, float], frame: Airframe, source: str) -> None:
                if k in values]
     checks += [(f"airframe.inertia[{i}]", v, 1e-5, 100.0, str(PARAMS_YAML)) for i, v in enumerate(frame.inertia)]
     for name, value, lo, hi, where in checks:
-        if not (math.isfinite(value) and lo <= value <= hi):
+        if not within(value, lo, hi):
             raise ConfigError(f"simulator parameter {name} = {value:g} ({where}): outside its physical range "
                               f"{lo:g}..{hi:g}")
