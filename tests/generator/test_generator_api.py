@@ -259,8 +259,9 @@ def _python_reply(line: bytes) -> str:
         r = dp.parse_reply(line)
     except dp.ReplyError as error:  # malformed: a reply of the kind of the line's longest prefix
         kinds = sorted((k for k in dp.ReplyKind if line.startswith(k.value.encode())), key=lambda k: len(k.value))
-        assert str(error).startswith("unknown reply") == (not kinds), error
-        return f"malformed {kinds[-1].value}" if kinds else "unknown -"
+        assert (error.reason == "unknown") == (not kinds) and error.reason in ("unknown", "malformed"), error
+        assert error.prefix == (kinds[-1].value if kinds else None), error
+        return f"{error.reason} {error.prefix or '-'}"
     if r.kind is dp.ReplyKind.READY:
         return f"ready {r.protocol} {r.fingerprint} {r.integrity}"
     command = dp.find_command(r.category.value, r.direction) if r.category and r.direction else None

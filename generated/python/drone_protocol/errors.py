@@ -66,7 +66,13 @@ class MissingValueError(ProtocolError, TypeError):
 
 
 class ReplyError(ProtocolError):
-    """A line from the Arduino that is not a reply of the spec."""
+    """A line from the Arduino that is not a reply of the spec. ``reason`` names why, as the other languages do:
+    ``"unknown"`` (no reply's prefix), ``"malformed"`` (``prefix`` is the reply it starts like) or ``"bad_check"``."""
+
+    def __init__(self, message: str, reason: str, prefix: str | None = None) -> None:
+        super().__init__(message)
+        self.reason = reason
+        self.prefix = prefix
 
 
 class ClockError(ProtocolError):

@@ -97,8 +97,8 @@ def _parse(body: bytes) -> Reply:
             if ready is not None:
                 return Reply(kind, protocol=ready[1], fingerprint=ready[2], integrity=ready[3])
             raise ReplyError(f"malformed ready reply {text!r}: expected '{kind.value} <protocol> <fingerprint> "
-                             "<integrity>'")
-        rest, state, laser = _status(text, rest)
+                             "<integrity>'", "malformed", kind.value)
+        rest, state, laser = _status(text, rest, kind)
         if kind is ReplyKind.ACCEPTED:
             if len(rest) == 2 and ord(rest[0]) in BY_BYTES and ord(rest[1]) in BY_BYTES[ord(rest[0])]:
                 return Reply(kind, category=Category(rest[0]), direction=rest[1], state=state, laser=laser)
@@ -108,19 +108,20 @@ def _parse(body: bytes) -> Reply:
                 return Reply(kind, error=error, state=state, laser=laser)
         elif rest == "":
             return Reply(kind, state=state, laser=laser)
-        raise ReplyError(f"malformed {kind.name.lower()} reply {text!r}")
+        raise ReplyError(f"malformed {kind.name.lower()} reply {text!r}", "malformed", kind.value)
     starts = "".join(k.value[0] for k in ReplyKind)
-    raise ReplyError(f"unknown reply {text!r}: expected a line starting with one of {allowed(starts)}")
+    raise ReplyError(f"unknown reply {text!r}: expected a line starting with one of {allowed(starts)}", "unknown")
 
 
-def _status(text: str, rest: str) -> tuple[str, DroneState, bool]:
+def _status(text: str, rest: str, kind: ReplyKind) -> tuple[str, DroneState, bool]:
     """Split the status off the end of a reply: (the rest, the state, the laser)."""
     cut = len(rest) - 2 - len(STATUS_SEPARATOR)
     if cut >= 0 and rest[cut:cut + len(STATUS_SEPARATOR)] == STATUS_SEPARATOR:
         state, laser = _STATES.get(rest[-2]), _LASER.get(rest[-1])
         if state is not None and laser is not None:
             return rest[:cut], state, laser
-    raise ReplyError(f"reply {text!r} does not end with the drone's status ('{STATUS_SEPARATOR}' + state + laser)")
+    raise ReplyError(f"reply {text!r} does not end with the drone's status ('{STATUS_SEPARATOR}' + state + laser)",
+                     "malformed", kind.value)
 
 
 def _line(text: str) -> bytes:

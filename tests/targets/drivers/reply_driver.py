@@ -13,13 +13,7 @@ def judge(line: bytes) -> str:
     try:
         reply = p.parse_reply(line)
     except p.ReplyError as error:
-        text = str(error)
-        if text.startswith("unknown reply"):
-            return "unknown"
-        kind = next((k for k in p.ReplyKind if text.startswith(f"malformed {k.name.lower()} reply")), None)
-        if kind is not None:
-            return f"malformed {kind.value}"
-        return "bad_check" if "check" in text else f"other {text}"
+        return f"malformed {error.prefix}" if error.reason == "malformed" else error.reason
     if reply.kind is p.ReplyKind.READY:
         return f"ready {reply.protocol} {reply.fingerprint} {reply.integrity}"
     return f"ok {reply.kind.name.lower()}"
