@@ -33,6 +33,8 @@ _AXES = (dp.ChannelName.ROLL, dp.ChannelName.PITCH)
 _SENSE = {dp.CommandName.MOVE_RIGHT: (dp.ChannelName.ROLL, 1.0), dp.CommandName.MOVE_LEFT: (dp.ChannelName.ROLL, -1.0),
           dp.CommandName.MOVE_FORWARD: (dp.ChannelName.PITCH, 1.0),
           dp.CommandName.MOVE_BACKWARD: (dp.ChannelName.PITCH, -1.0)}
+_LEAN = {axis_sense: name for name, axis_sense in _SENSE.items()}  # (axis, sense) -> the command that leans so
+_STICK_TARGETS = frozenset(c.value for c in dp.ChannelName)  # a command of these targets sets a stick
 
 
 class Drift:
@@ -117,7 +119,7 @@ class TrimSticks:
                 frame = self._lean_frame(name, _clamp(due / dt, self._max_pulse_deg))
                 own = False
         elif command.name in (dp.CommandName.MOVE_FORWARD, dp.CommandName.MOVE_BACKWARD):
-            sense = 1.0 if command.name is dp.CommandName.MOVE_FORWARD else -1.0
+            _, sense = _SENSE[command.name]
             deg = self._pulses.lean_deg(command.value - dp.CHANNELS[dp.ChannelName.PITCH].median)
             frame = self._lean_frame(dp.ChannelName.PITCH, sense * deg + forward_trim_deg)
         self.sent(frame, now_ms, own)
@@ -141,10 +143,7 @@ class TrimSticks:
     def _lean_frame(self, name: dp.ChannelName, deg: float) -> bytes:
         offset = self._pulses.lean_offset_us(name, deg)
         median = dp.CHANNELS[name].median
-        if name is dp.ChannelName.ROLL:
-            cmd = dp.CommandName.MOVE_RIGHT if offset >= 0 else dp.CommandName.MOVE_LEFT
-        else:
-            cmd = dp.CommandName.MOVE_FORWARD if offset >= 0 else dp.CommandName.MOVE_BACKWARD
+        cmd = _LEAN[name, 1.0 if offset >= 0 else -1.0]
         spec = dp.COMMANDS[cmd]
         value = max(spec.minimum, min(spec.maximum, median + offset))
         return dp.command_frame(cmd, value)
@@ -156,7 +155,7 @@ def _decode(frame: bytes | None) -> dp.Command | None:
     if command is None:
         return None
     target = dp.COMMANDS[command.name].target
-    if target in {c.value for c in dp.ChannelName} or command.name is dp.CommandName.HOLD_ALTITUDE:
+    if target in _STICK_TARGETS or command.name is dp.CommandName.HOLD_ALTITUDE:
         return command
     return None
 
