@@ -116,7 +116,8 @@ class Sensor:
         rgb = self.renderer.render()
         t1 = time.process_time()
         self.render_ms = (t1 - t0) * 1000.0
-        img: Image = self._sensor(np.ascontiguousarray(rgb[..., ::-1]), t)
+        # OpenCV's channel swap: numpy's copy of a reversed view cost ten times as much (0.7 ms at 320x240)
+        img: Image = self._sensor(np.asarray(cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR), dtype=np.uint8), t)
         self.sensor_ms = (time.process_time() - t1) * 1000.0
         return img
 
