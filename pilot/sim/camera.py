@@ -70,6 +70,10 @@ class Sensor:
         self.sc, self.cam, self.model, self.data = scenario, camera, model, data
         self.cam_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, "eye")
         self.renderer = mujoco.Renderer(model, camera.height, camera.width)
+        # Mesa compiles its shaders at their first draw (40-50 ms at 320x240): a cost of building the world, drawn
+        # once here rather than in the flight's first frame
+        self.renderer.update_scene(data, camera=self.cam_id)
+        self.renderer.render()
         self.gain = 1.0
         self.white = (1.0, 1.0, 1.0)  # auto white balance's gains, B, G, R
         self.effects = scenario.effects
