@@ -102,10 +102,12 @@ def write(path: Path, executable: str | None, seconds: float, baseline: Path | N
         f"one after another, each for at most {seconds:g} s"
         + (f"; each flown first by the baseline tree ({baseline.name}) then by this one: before → after, "
            "under the same load" if baseline else "") + ".",
+        "",
         "CPU time of the process (the machine's other load still slows it: compare rows of one run). Physics "
         "(with the flight controller and its estimator) per 50 ms tick of simulated time; MuJoCo's render (with "
         "posing the past for the frame's latency) and the sensor's effects per frame; simulator alone: 50 ms over "
-        "their sum (goal: 3x at 320x240, randomised).",
+        "their sum (goal: 3x at 320x240, randomised). The whole loop is simulated over wall time: the other engineers' "
+        "load moves it most.",
         "", *table, ""])
     path.write_text(text)
     return text
