@@ -19,6 +19,12 @@ CAMERA_POS = (0.23, 0.0, -0.03)  # on the airframe's nose, below the arms
 ZNEAR = 0.001  # the camera's near clipping plane, in the room's extents (about 1 cm): at MuJoCo's 0.01 (11 cm), a
 # wall within 9 cm of the airframe's nose vanished, and the camera saw the black outside the room
 SHADOW_MAP_PX = 256  # the shadow map's side: soft shadows, as under diffuse room light; 1024 cost 1.5x the render
+# MuJoCo draws a plane as a grid of quads of this side (its size's third figure) and lights it per vertex: the
+# floor's and walls' light pools need a grid well under the lights' spread (a few metres), and each visible quad
+# costs the software renderer in each of its three passes (colour, shadow map, shadowed light). 0.25 m moves a
+# pixel by 0.2 grey levels on average from 0.1 m and saves a third of the render. Small planes keep 0.1 m.
+ROOM_GRID_M = 0.25
+SMALL_GRID_M = 0.1
 MOTOR_SPIN = (1, -1, 1, -1)  # front-left, front-right... alternating directions cancel the reaction torque
 
 
@@ -43,7 +49,7 @@ def motor_positions(arm: float) -> list[tuple[float, float]]:
 
 
 def _wall_plane(name: str, x: float, y: float, z: float, normal_heading: float, half: tuple[float, float],
-                material: str, offset: float = 0.0, solid: bool = True) -> str:
+                material: str, offset: float = 0.0, solid: bool = True, grid: float = SMALL_GRID_M) -> str:
     """A plane facing into the room (its normal along ``normal_heading``); x axis = up x normal. MuJoCo collides
     with a plane as an infinite half-space, whatever its size (which is only drawn): a plane that is not
     ``solid`` (a picture on a wall, the marker on its backing board) is seen and hit by the laser's ray, never
@@ -51,7 +57,7 @@ def _wall_plane(name: str, x: float, y: float, z: float, normal_heading: float, 
     nx, ny = math.cos(normal_heading), math.sin(normal_heading)
     touch = "" if solid else ' contype="0" conaffinity="0"'
     return (f'<geom name="{name}" type="plane" pos="{_f(x + offset * nx, y + offset * ny, z)}" '
-            f'xyaxes="{_f(-ny, nx, 0, 0, 0, 1)}" size="{_f(half[0], half[1], 0.1)}" material="{material}"{touch}/>')
+            f'xyaxes="{_f(-ny, nx, 0, 0, 0, 1)}" size="{_f(half[0], half[1], grid)}" material="{material}"{touch}/>')
 
 
 class _Writer:
@@ -109,16 +115,19 @@ def build(scenario: Scenario, frame: Airframe, width: int, height: int, fovy_deg
     w.colour_material("airframe", (0.1, 0.1, 0.1))
     body: list[str] = [
         f'<geom name="floor" type="plane" pos="{_f(room.width / 2, room.depth / 2, 0)}" '
-        f'size="{_f(room.width / 2, room.depth / 2, 0.1)}" material="{floor}"/>',
+        f'size="{_f(room.width / 2, room.depth / 2, ROOM_GRID_M)}" material="{floor}"/>',
+        # one quad: the lights hang below it and shine down, so it shows the ambient light alone, the same at
+        # every vertex
         f'<geom name="ceiling" type="plane" pos="{_f(room.width / 2, room.depth / 2, room.height)}" '
-        f'xyaxes="1 0 0 0 -1 0" size="{_f(room.width / 2, room.depth / 2, 0.1)}" material="{ceiling}"/>',
+        f'xyaxes="1 0 0 0 -1 0" size="{_f(room.width / 2, room.depth / 2, max(room.width, room.depth))}" '
+        f'material="{ceiling}"/>',
     ]
     half_h = room.height / 2
     for name, x, y, heading, length in (("wall_south", room.width / 2, 0.0, math.pi / 2, room.width),
                                         ("wall_east", room.width, room.depth / 2, math.pi, room.depth),
                                         ("wall_north", room.width / 2, room.depth, -math.pi / 2, room.width),
                                         ("wall_west", 0.0, room.depth / 2, 0.0, room.depth)):
-        body.append(_wall_plane(name, x, y, half_h, heading, (length / 2, half_h), walls))
+        body.append(_wall_plane(name, x, y, half_h, heading, (length / 2, half_h), walls, grid=ROOM_GRID_M))
     body += [w.prop(i, p) for i, p in enumerate(sc.props)]
     tx, ty, tz = sc.target.position
     if sc.window:  # a bright window on the wall behind the target, as seen from the start

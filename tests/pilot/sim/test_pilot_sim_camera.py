@@ -101,3 +101,13 @@ def test_the_pi_camera_profile_reads_its_rows_over_its_readout_time() -> None:
         assert view.sensor.readout_s == 0.025
     finally:
         view.close()
+
+
+def test_the_scene_is_drawn_once_when_the_camera_is_built() -> None:
+    """Mesa compiles its shaders at their first draw: that belongs to building the world, not to the first frame
+    (whose cost the speed probe counts)."""
+    view = StillView(make_scenario("ahead", 2), CameraModel(160, 120))
+    try:
+        assert view.sensor.renderer.scene.ngeom > 0
+    finally:
+        view.close()

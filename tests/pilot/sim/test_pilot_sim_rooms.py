@@ -13,7 +13,8 @@ from sim_rig import PARAMS
 from pilot.sim import textures
 from pilot.sim.everyday import CLOTHING, SKIN
 from pilot.sim.room import SCENARIOS, make_scenario
-from pilot.sim.scene import build
+from pilot.sim.scenario import Room
+from pilot.sim.scene import ROOM_GRID_M, build
 
 SEEDS = range(6)
 
@@ -62,3 +63,20 @@ def test_the_occluding_panel_stands_on_the_floor() -> None:
     sc = make_scenario("occluded", 1)
     panel = [p for p in sc.props if p.shape == "box" and p.size[0] == 0.02]
     assert len(panel) == 1 and panel[0].position[2] == pytest.approx(panel[0].size[2])
+
+
+def test_the_room_is_drawn_in_quads_as_coarse_as_its_lighting_allows() -> None:
+    """MuJoCo lights a plane per vertex of its grid, and each quad costs the software renderer: the floor and the
+    walls in quads of ROOM_GRID_M, the ceiling (which the down-pointing lights never reach) in one."""
+    grids: dict[str, float] = {}
+    for name in SCENARIOS:
+        sc = make_scenario(name, 1)
+        xml = build(sc, PARAMS.airframe, 64, 48, 45.0).xml
+        grids |= {g: float(v) for g, v in re.findall(r'name="(floor|ceiling|wall_\w+)" type="plane".*?size="'
+                                                      r'[\d.]+ [\d.]+ ([\d.]+)"', xml)}
+        for light in sc.lights:  # MuJoCo's spot cutoff: 45 degrees; the ceiling lies 90 degrees off straight down
+            dx, dy, dz = light.direction
+            assert math.degrees(math.acos(-dz / math.hypot(dx, dy, dz))) + 45.0 < 90.0, (name, light)
+    assert grids.pop("ceiling") >= max(Room().width, Room().depth)
+    assert set(grids) == {"floor", "wall_south", "wall_east", "wall_north", "wall_west"}
+    assert set(grids.values()) == {ROOM_GRID_M}
