@@ -49,7 +49,8 @@ class Stream:
 
 
 Handler = Callable[[str, str, str], "Response | Stream"]  # (method, path, client address) -> answer
-Frames = Callable[[], "tuple[int, bytes] | None"]  # the newest (sequence number, part bytes)
+Frames = Callable[[], "tuple[int, bytes] | None"]  # the newest (sequence number, part bytes), encoded on demand
+Newest = Callable[[], int]  # the newest frame's sequence number (0: none yet), without encoding it
 
 ACCEPT_BURST = 32.0
 SEND_BUFFER = 128 * 1024  # the kernel's share of a viewer's backlog: two or three frames
@@ -88,14 +89,17 @@ class _RateLimitedLog:
 
 
 class Server:
-    """Serves ``handler`` and, to streams, ``frames`` at up to ``fps``; ``close()`` stops it."""
+    """Serves ``handler`` and, to streams, ``frames`` at up to ``fps``; ``close()`` stops it. ``frames`` is asked
+    only when a viewer is behind ``newest`` and ready to take a frame."""
 
-    def __init__(self, host: str, port: int, handler: Handler, frames: Frames, *, limits: Limits = DEFAULT_LIMITS,
+    def __init__(self, host: str, port: int, handler: Handler, frames: Frames, newest: Newest, *,
+                 limits: Limits = DEFAULT_LIMITS,
                  fps: float = 25.0, log: Callable[[str], None] = print,
                  clock: Callable[[], float] = time.monotonic) -> None:
         if limits.viewers < 1 or limits.connections <= limits.viewers:
             raise PilotError(f"live view: {limits.connections} connections must exceed {limits.viewers} viewers")
         self.limits, self._handler, self._frames, self._period = limits, handler, frames, 1.0 / fps
+        self._newest = newest
         self._clock = clock
         self.log = _RateLimitedLog(log, clock)
         family = socket.AF_INET6 if ":" in host else socket.AF_INET
@@ -322,17 +326,23 @@ class Server:
                 if not conn.out:
                     self._drop(conn)
             return
-        frame = self._frames()
-        if frame is None:
-            return
-        seq, part = frame
+        newest = self._newest()
+        ready = []
         for conn in streams:
-            if conn.seq >= seq:
+            if conn.seq >= newest:
                 continue
             if conn.out:  # still taking an earlier frame: this one is skipped, never queued
                 conn.dropped += 1
                 self.dropped += 1
-                continue
+            else:
+                ready.append(conn)
+        if not ready:  # nobody can take it: it is not even encoded
+            return
+        frame = self._frames()
+        if frame is None:
+            return
+        seq, part = frame
+        for conn in ready:
             conn.seq = seq
             self._queue(conn, part)
 
