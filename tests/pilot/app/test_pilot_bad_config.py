@@ -69,3 +69,10 @@ def test_record_into_an_existing_folder_that_cannot_be_written_is_refused_at_sta
     code, out, err = call("--record", "/sys", "--max-seconds", "1", "--no-status")
     assert code == 2 and out == ""
     assert err.startswith("pilot: error: option --record: cannot write into '/sys': ") and err.count("\n") == 1, err
+
+
+@pytest.mark.parametrize("folder", ["", "  "])
+def test_record_into_an_empty_name_is_refused_not_ignored(folder: str) -> None:
+    code, out, err = call("--record", folder, "--max-seconds", "1", "--no-status")
+    assert code == 2 and out == ""  # it flew without recording before
+    assert err == "pilot: error: option --record: expected a folder, got an empty name\n", err
