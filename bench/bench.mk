@@ -95,6 +95,8 @@ bench-tools: deps firmware-host
 bench-sidechan: deps firmware-host
 	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.sidechan.liveview_load $(BENCH_SIDECHAN_FLAGS)
 	$(PY) -m bench.sidechan.liveview_load --synthetic-pairs 6
+	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.sidechan.liveview_cost
+	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.sidechan.liveview_cost --realtime 10
 	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.sidechan.disk_full
 	$(PY) -m bench.sidechan.generator_kills
 	$(PY) -m bench.sidechan.bad_configs
