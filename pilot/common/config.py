@@ -334,8 +334,7 @@ def _read_text(path: Path, where: str) -> str:
     try:  # without blocking: a FIFO would otherwise wait for a writer for ever
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
         with open(fd, "rb") as f:
-            mode = os.fstat(fd).st_mode
-            if not stat.S_ISREG(mode):
+            if not stat.S_ISREG(mode := os.fstat(fd).st_mode):
                 kind = "a folder" if stat.S_ISDIR(mode) else "not a regular file (a FIFO, a device or a socket)"
                 raise ConfigError(f"{where}: cannot read config: it is {kind}")
             raw = f.read(MAX_CONFIG_BYTES + 1)
