@@ -310,10 +310,10 @@ def summary(runs: list[dict[str, Any]], paced: bool) -> list[str]:
         q1, q2, q3 = (ratios[int(q * (len(ratios) - 1))] for q in (0.25, 0.5, 0.75))
         lines += ["", f"Turn by turn (the n-th pilot turn against the n-th decoy turn, {len(ratios)} pairs): the "
                   f"pilot's rate {q2:+.1f} % (median; quartiles {q1:+.1f} %, {q3:+.1f} %) of the decoy's."]
-    cost = 100 * (hz["pilot"] / hz["none"] - 1)
+    cost, own = (100 * (hz["pilot"] / hz[c] - 1) for c in ("none", "decoy"))
     lines += ["", f"Goal, the loop's rate within 5 % of no viewers: {cost:+.1f} % with the 300 clients on the "
-              f"pilot's view ({'met' if abs(cost) <= 5 else 'missed'}); "
-              f"{sum(r['tracebacks'] for r in sel)} tracebacks."]
+              f"pilot's view ({'met' if abs(cost) <= 5 else 'missed'}), of which the view's own "
+              f"(against the same crowd on the decoy) {own:+.1f} %; {sum(r['tracebacks'] for r in sel)} tracebacks."]
     return [*lines, ""]
 
 
