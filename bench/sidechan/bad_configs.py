@@ -2,9 +2,9 @@
 
 ``contents()`` is the generated set of bad file contents (nesting, encodings, YAML tags, huge numbers, wrong
 types, broken YAML, binary junk); ``make_files`` writes them into a folder and adds what no content can be: a
-folder, a FIFO, a symlink loop, a dangling link, a path through a file, a name with a newline. The test
-(tests/pilot/app/test_pilot_bad_config.py) calls the pilot in-process on them; the bench runs each in its own
-process, as a user would, and counts tracebacks, exit codes other than 2, lines other than one, and hangs.
+folder, a FIFO, a symlink loop, a dangling link, a path through a file, a name with a newline, an unreadable
+file. The test (tests/pilot/app/test_pilot_bad_config.py) calls the pilot in-process on them; the bench runs each
+in its own process, as a user would, and counts tracebacks, exit codes other than 2, lines other than one, hangs.
 
     python -m bench.sidechan.bad_configs     (writes bench/sidechan/RESULTS-bad-configs.md)
 """
@@ -33,6 +33,7 @@ WRONG = ["'text'", "[1, 2]", "{a: 1}", "true", "null", "1.5", "-7", "''", "[[1, 
 TAGS = ("!!python/object/apply:os.system ['true']", "!!python/name:os.system", "!!binary aGVsbG8=", "!!set {a, b}",
         "!!timestamp 2001-12-14", "!!omap [a: 1]", "!custom 5", "!!float abc", "!!int x", "!!str",
         "!!python/tuple [1, 2]", "!!pairs [a: 1]")
+WRITE_ONLY = "/proc/sys/vm/compact_memory"  # mode 0200: unreadable even by root
 HUGE = ("1e999", "-1e999", "9" * 5000, "-" + "9" * 4000, "9" * 400, ".nan", ".inf", "-.inf", "0x" + "f" * 3000)
 
 
@@ -110,7 +111,13 @@ def make_files(root: Path, *, kinds_only: bool = False) -> list[tuple[str, str]]
     (kinds / "plain").write_text("detector: hsv\n")
     newline = kinds / "two\nlines.yaml"
     newline.write_bytes(b"detector: 5\n")
-    made += [("a folder", str(kinds / "folder.yaml")), ("a FIFO", str(fifo)),
+    unreadable = kinds / "unreadable.yaml"
+    unreadable.unlink(missing_ok=True)  # a mode-0 file from an earlier run cannot be written again
+    unreadable.write_text("detector: hsv\n")
+    unreadable.chmod(0)
+    if os.geteuid() == 0 and Path(WRITE_ONLY).exists():  # root reads any mode-0 file; not this one
+        unreadable = Path(WRITE_ONLY)
+    made += [("an unreadable file", str(unreadable)), ("a folder", str(kinds / "folder.yaml")), ("a FIFO", str(fifo)),
              ("a symlink loop", str(kinds / "loop.yaml")), ("a dangling symlink", str(kinds / "dangling.yaml")),
              ("a path through a file", str(kinds / "plain" / "pilot.yaml")),
              ("no such file", str(kinds / "missing.yaml")), ("a name with a newline", str(newline)),

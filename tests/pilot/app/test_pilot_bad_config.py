@@ -39,7 +39,7 @@ def test_a_malformed_config_is_one_line_naming_the_file_exit_2(name: str, conten
     assert sorted(tmp_path.iterdir()) == before  # nothing written
 
 
-@pytest.mark.parametrize("kind", ["a folder", "a FIFO", "a symlink loop", "a dangling symlink",
+@pytest.mark.parametrize("kind", ["an unreadable file", "a folder", "a FIFO", "a symlink loop", "a dangling symlink",
                                   "a path through a file", "no such file", "a name with a newline",
                                   "a character device of zeros"])
 def test_what_is_no_config_file_is_one_line_exit_2(kind: str, tmp_path: Path) -> None:
