@@ -203,6 +203,7 @@ def one_flight(decoy_url: str, executable: str | None, seconds: float, paced: bo
     per = judge(probe, sleep, turns.turns)
     return {"paced": paced, "ticks": len(probe.times), "wall_s": round(flight.wall_seconds, 1),
             "turns": len(turns.turns) - 1, "conditions": per,
+            "server_longest_busy_ms": round(1000 * view.server.longest_busy_s, 2),
             "rss_peak_mb": round(rss_peak_mb(), 1), "rss_mb": {k: round(v, 1) for k, v in turns.rss.items()},
             "peak_connections": turns.peak_connections,
             "peak_viewers": turns.peak_viewers,
@@ -376,6 +377,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"condition: {rss_by_condition(runs)} MB),"
         " at most "
         f"{max(r['peak_connections'] for r in runs)} sockets and {max(r['peak_viewers'] for r in runs)} viewers; "
+        "the server thread's longest stretch of processor time between two waits (the longest it can have held "
+        f"the interpreter lock, encoding included) {max(r['server_longest_busy_ms'] for r in runs):.1f} ms; "
         f"{sum(r['tracebacks'] for r in runs)} tracebacks, {sum(r['log_lines'] for r in runs)} log lines from "
         "the server.", "",
         "Each flight:", "", "```", *(json.dumps(r) for r in runs), "```", ""])

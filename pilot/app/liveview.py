@@ -21,11 +21,12 @@ from typing import Any
 
 import cv2
 import drone_protocol as dp
+import numpy as np
 
 from ..common.errors import PilotError
 from .liveserver import DEFAULT_LIMITS, Limits, Response, Server, Stream
 from .observers import StopSwitch
-from .overlay import annotate
+from .overlay import annotate, outlined_text
 from .runner import Tick
 
 BOUNDARY = "liveviewframe"
@@ -101,7 +102,7 @@ class LiveView:
         self._page = resources.files(__package__).joinpath("liveview.html").read_bytes()
         self.encoded = 0  # frames drawn and encoded (at most one per frame, and only for a viewer ready for it)
         self.server = Server(host, port, self._handle, self._part, self._newest, limits=limits, fps=MAX_FPS,
-                             log=log or (lambda line: print(line, file=sys.stderr, flush=True)))
+                             log=log or (lambda line: print(line, file=sys.stderr, flush=True)), warm_up=_warm_up)
         self._closed = False
 
     @property
@@ -236,6 +237,12 @@ class LiveView:
             "stop_requested": self.stop.requested,
             "ended": snap.ended,
         }
+
+
+def _warm_up() -> None:
+    """OpenCV sets up its Hershey font in each thread at its first putText (30 ms of processor time): the server's
+    thread does it as it starts, before the flight, not when the first viewer comes."""
+    outlined_text(np.zeros((24, 48, 3), np.uint8), "0", (2, 18), 0.45)
 
 
 def _reply_text(reply: dp.Reply) -> str:
