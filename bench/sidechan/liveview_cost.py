@@ -377,8 +377,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"condition: {rss_by_condition(runs)} MB),"
         " at most "
         f"{max(r['peak_connections'] for r in runs)} sockets and {max(r['peak_viewers'] for r in runs)} viewers; "
-        "the server thread's longest stretch of processor time between two waits (the longest it can have held "
-        f"the interpreter lock, encoding included) {max(r['server_longest_busy_ms'] for r in runs):.1f} ms; "
+        "the server thread's longest stretch of processor time between two waits (encoding included; the "
+        "interpreter lock is released in OpenCV's calls and handed over every switch interval on request) "
+        f"{max(r['server_longest_busy_ms'] for r in runs):.1f} ms; "
         f"{sum(r['tracebacks'] for r in runs)} tracebacks, {sum(r['log_lines'] for r in runs)} log lines from "
         "the server.", "",
         "Each flight:", "", "```", *(json.dumps(r) for r in runs), "```", ""])
