@@ -29,8 +29,8 @@
 #                         bench/flight/RESULTS-hsv-from500.md)
 #   make bench-flight-strict  the strict campaign on held-out seeds (both detectors, gusts), then HSV with speed
 #                         steps of 150 and 70 µs; bench/flight/RESULTS-held-out.md, RESULTS-step150.md, -step70.md
-#   make bench-sidechan   the live view under 300 hostile clients (the loop's rate, gaps, memory), disk-full flights
-#                         and the generator killed mid-run; writes bench/sidechan/RESULTS*.md
+#   make bench-sidechan   the live view under 300 hostile clients (the loop's rate, gaps, memory), disk-full flights,
+#                         the generator killed mid-run and malformed configs; writes bench/sidechan/RESULTS*.md
 #   make bench            every part's benchmark: bench-protocol, bench-generator, bench-firmware
 #                         (firmware/firmware.mk), bench-pilot (pilot/pilot.mk), bench-vision, bench-ide
 #                         (bench/ide/bench.mk), bench-rust-c (tests/targets/targets.mk) and bench-tools
@@ -95,8 +95,11 @@ bench-tools: deps firmware-host
 bench-sidechan: deps firmware-host
 	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.sidechan.liveview_load $(BENCH_SIDECHAN_FLAGS)
 	$(PY) -m bench.sidechan.liveview_load --synthetic-pairs 6
+	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.sidechan.liveview_cost
+	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.sidechan.liveview_cost --realtime 10
 	PILOT_VIRTUAL_DRONE=$(FW_BUILD)/host/virtual_drone $(PY) -m bench.sidechan.disk_full
 	$(PY) -m bench.sidechan.generator_kills
+	$(PY) -m bench.sidechan.bad_configs
 
 # Recipes come from firmware/firmware.mk and pilot/pilot.mk; a part that has none yet benchmarks nothing.
 bench-firmware bench-pilot:

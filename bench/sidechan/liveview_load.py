@@ -183,13 +183,21 @@ def _f(run: dict[str, object], key: str) -> float:
     return float(str(run[key]))
 
 
+def _spread(runs: list[dict[str, object]]) -> str:
+    quiet = [_f(r, "hz") for r in runs if not r["load"]]
+    return f"{min(quiet):.1f}-{max(quiet):.1f} Hz" if quiet else "no rate"
+
+
 def render(runs: list[dict[str, object]], rounds: int, seconds: float) -> str:
     lines = ["# The live view under load (`make bench-sidechan`)", "",
              f"{rounds} rounds; each: the simulated flight (ahead, seed 2, {seconds:g} s at most) paced "
              "and unpaced, with no client and with 300 (75 each: viewers, idle, slow, resetting), default limits "
              "(4 viewers, 32 sockets). The machine's 2 cores are shared: each run records the load average, "
              "and a paced flight that falls short of 20 Hz without any client says the machine, not the live "
-             "view, was short of processor time. The server thread's own processor time is the view's cost.", "",
+             "view, was short of processor time. The server thread's own processor time is the view's cost. "
+             f"The flights without a client alone ran at {_spread(runs)}: whole flights of one condition against "
+             "another compare the machine's moments as much as the conditions; the turns of "
+             "bench.sidechan.liveview_cost (below) separate the view's cost from the machine's.", "",
              "| mode | clients | rate (Hz, median) | rate vs no client | longest gap (ms, max) | tracebacks | "
              "peak RSS (MB) | peak sockets | frames dropped | server thread CPU (% of the flight) |",
              "|---|---|---|---|---|---|---|---|---|---|"]

@@ -1,9 +1,10 @@
 """A crowd of hostile and careless live-view clients, in its own process (its own interpreter lock).
 
-``python -m bench.sidechan.swarm URL --viewers N --idle N --slow N --reset N --seconds S`` keeps that many
-clients of each kind going until the time is up, reconnecting each one the server closes, and prints one
-JSON object: connections made, frames (MJPEG parts) read, refusals, and the latency of ``state.json``
-polled once every 200 ms by one well-behaved client (the page's own poll, which must stay reachable).
+``python -m bench.sidechan.swarm URL --viewers N --idle N --slow N --reset N --seconds S [--nice N]`` keeps that
+many clients of each kind going until the time is up (or SIGTERM), reconnecting each one the server closes, and
+prints one JSON object: connections made, frames (MJPEG parts) read, refusals, the latency of ``state.json``
+polled once every 200 ms by one well-behaved client (the page's own poll, which must stay reachable), and the
+swarm's own processor time (what the crowd took from the machine).
 
 * viewer: reads ``stream.mjpg`` as fast as it comes;
 * idle: connects and never sends a byte;
@@ -16,6 +17,9 @@ from __future__ import annotations
 import argparse
 import asyncio
 import json
+import os
+import resource
+import signal
 import socket
 import struct
 import time
@@ -34,6 +38,9 @@ class Swarm:
 
     def alive(self) -> bool:
         return time.monotonic() < self.deadline
+
+    def stop(self) -> None:
+        self.deadline = time.monotonic()
 
     async def connections(self) -> AsyncIterator[tuple[asyncio.StreamReader, asyncio.StreamWriter]]:
         """A new connection each time round, until the time is up."""
@@ -117,14 +124,22 @@ async def _run(args: argparse.Namespace) -> dict[str, object]:
     tasks += [swarm.reset() for _ in range(args.reset)]
     tasks.append(swarm.poll_state())
     running = [asyncio.ensure_future(t) for t in tasks]
-    await asyncio.wait(running, timeout=args.seconds + 1.0)  # a client stuck in a connect or a read is cut off
+    stopped = asyncio.Event()
+    asyncio.get_running_loop().add_signal_handler(signal.SIGTERM, stopped.set)
+    everyone: asyncio.Future[object] = asyncio.ensure_future(asyncio.gather(*running, return_exceptions=True))
+    waiter: asyncio.Future[object] = asyncio.ensure_future(stopped.wait())
+    await asyncio.wait([everyone, waiter], timeout=args.seconds + 1.0, return_when=asyncio.FIRST_COMPLETED)
+    swarm.stop()  # a client stuck in a connect or a read is cut off
+    waiter.cancel()
     for task in running:
         task.cancel()
     await asyncio.gather(*running, return_exceptions=True)
     ms = sorted(swarm.state_ms)
+    use = resource.getrusage(resource.RUSAGE_SELF)
     return {**swarm.counts, "state polls": len(ms),
             "state p50 ms": round(ms[len(ms) // 2], 1) if ms else None,
-            "state max ms": round(ms[-1], 1) if ms else None}
+            "state max ms": round(ms[-1], 1) if ms else None,
+            "cpu_s": round(use.ru_utime + use.ru_stime, 2), "rss_mb": round(use.ru_maxrss / 1024, 1)}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -133,7 +148,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     for kind in ("viewers", "idle", "slow", "reset"):
         p.add_argument(f"--{kind}", type=int, default=0)
     p.add_argument("--seconds", type=float, default=10.0)
+    p.add_argument("--nice", type=int, default=0, help="lower the swarm's priority by this much")
     args = p.parse_args(argv)
+    if args.nice:
+        os.nice(args.nice)
     print(json.dumps(asyncio.run(_run(args))), flush=True)
     return 0
 

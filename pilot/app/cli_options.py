@@ -28,6 +28,8 @@ def check_sources(args: argparse.Namespace) -> None:
     given = [f"--{name}" for name in SOURCE_OPTIONS if getattr(args, name) is not None]
     if len(given) > 1:
         raise PilotError(f"options {' and '.join(given)} exclude each other: pick one frame source")
+    if args.record is not None and not args.record.strip():
+        raise PilotError("option --record: expected a folder, got an empty name")
     if args.force and not args.record:
         raise PilotError("option --force only applies to --record DIR")
     if not 1 <= args.serve_viewers <= MAX_VIEWERS:

@@ -49,7 +49,8 @@ class Stream:
 
 
 Handler = Callable[[str, str, str], "Response | Stream"]  # (method, path, client address) -> answer
-Frames = Callable[[], "tuple[int, bytes] | None"]  # the newest (sequence number, part bytes)
+Frames = Callable[[], "tuple[int, bytes] | None"]  # the newest (sequence number, part bytes), encoded on demand
+Newest = Callable[[], int]  # the newest frame's sequence number (0: none yet), without encoding it
 
 ACCEPT_BURST = 32.0
 SEND_BUFFER = 128 * 1024  # the kernel's share of a viewer's backlog: two or three frames
@@ -88,14 +89,17 @@ class _RateLimitedLog:
 
 
 class Server:
-    """Serves ``handler`` and, to streams, ``frames`` at up to ``fps``; ``close()`` stops it."""
+    """Serves ``handler`` and, to streams, ``frames`` at up to ``fps``; ``close()`` stops it. ``frames`` is asked
+    only when a viewer is behind ``newest`` and ready to take a frame."""
 
-    def __init__(self, host: str, port: int, handler: Handler, frames: Frames, *, limits: Limits = DEFAULT_LIMITS,
+    def __init__(self, host: str, port: int, handler: Handler, frames: Frames, newest: Newest, *,
+                 limits: Limits = DEFAULT_LIMITS,
                  fps: float = 25.0, log: Callable[[str], None] = print,
-                 clock: Callable[[], float] = time.monotonic) -> None:
+                 clock: Callable[[], float] = time.monotonic, warm_up: Callable[[], None] | None = None) -> None:
         if limits.viewers < 1 or limits.connections <= limits.viewers:
             raise PilotError(f"live view: {limits.connections} connections must exceed {limits.viewers} viewers")
         self.limits, self._handler, self._frames, self._period = limits, handler, frames, 1.0 / fps
+        self._newest, self._warm_up = newest, warm_up
         self._clock = clock
         self.log = _RateLimitedLog(log, clock)
         family = socket.AF_INET6 if ":" in host else socket.AF_INET
@@ -117,6 +121,7 @@ class Server:
         self.evicted = 0  # connections closed to make room
         self.timed_out = 0  # connections closed for silence or a stall
         self.cpu_s = 0.0  # the server thread's own processor time
+        self.longest_busy_s = 0.0  # the most processor time between two waits: the longest it can hold the GIL
         self.dropped = 0  # frames not sent to a viewer that was still taking the previous one
         self._thread = threading.Thread(target=self._serve, name="liveview", daemon=True)
         self._thread.start()
@@ -157,6 +162,8 @@ class Server:
 
     # -- the server thread -------------------------------------------------------------------------------------
     def _serve(self) -> None:
+        if self._warm_up is not None:  # whatever the thread's first frame would otherwise pay for
+            self._warm_up()
         next_frame = self._clock()
         while not self._stopping:
             now = self._clock()
@@ -164,7 +171,9 @@ class Server:
             timeout = max(0.0, min(next_frame - now, 0.25)) if self.viewers else 0.25
             if not self._listening:
                 timeout = min(timeout, 1.0 / self.limits.accepts_per_s)
-            for key, events in self._sel.select(timeout):
+            ready = self._sel.select(timeout)
+            busy_from = time.thread_time()
+            for key, events in ready:
                 if key.fileobj is self._listener:
                     self._accept()
                 elif key.fileobj is self._wake_r:
@@ -182,6 +191,7 @@ class Server:
                 self._offer_frame()
             self._expire(now)
             self.cpu_s = time.thread_time()
+            self.longest_busy_s = max(self.longest_busy_s, self.cpu_s - busy_from)
 
     def _refill(self, now: float) -> None:
         self._tokens = min(ACCEPT_BURST, self._tokens + (now - self._refilled) * self.limits.accepts_per_s)
@@ -322,17 +332,23 @@ class Server:
                 if not conn.out:
                     self._drop(conn)
             return
-        frame = self._frames()
-        if frame is None:
-            return
-        seq, part = frame
+        newest = self._newest()
+        ready = []
         for conn in streams:
-            if conn.seq >= seq:
+            if conn.seq >= newest:
                 continue
             if conn.out:  # still taking an earlier frame: this one is skipped, never queued
                 conn.dropped += 1
                 self.dropped += 1
-                continue
+            else:
+                ready.append(conn)
+        if not ready:  # nobody can take it: it is not even encoded
+            return
+        frame = self._frames()
+        if frame is None:
+            return
+        seq, part = frame
+        for conn in ready:
             conn.seq = seq
             self._queue(conn, part)
 

@@ -6,7 +6,9 @@ Every error names the offending option by its dotted path (``controller.fire_ms`
 from __future__ import annotations
 
 import dataclasses
+import os
 import reprlib
+import stat
 import typing
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -329,8 +331,12 @@ MAX_CONFIG_BYTES = 1_000_000  # a config is a few kilobytes; this bounds what a 
 
 
 def _read_text(path: Path, where: str) -> str:
-    try:
-        with path.open("rb") as f:
+    try:  # without blocking: a FIFO would otherwise wait for a writer for ever
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+        with open(fd, "rb") as f:
+            if not stat.S_ISREG(mode := os.fstat(fd).st_mode):
+                kind = "a folder" if stat.S_ISDIR(mode) else "not a regular file (a FIFO, a device or a socket)"
+                raise ConfigError(f"{where}: cannot read config: it is {kind}")
             raw = f.read(MAX_CONFIG_BYTES + 1)
     except OSError as exc:
         raise ConfigError(f"{where}: cannot read config: {exc.strerror or exc}") from exc
@@ -359,7 +365,7 @@ def _yaml_problem(exc: yaml.YAMLError) -> str:
 
 
 def load(path: str | Path) -> PilotConfig:
-    where = str(path)
+    where = str(path) if str(path).isprintable() else repr(str(path))  # a newline in a name keeps to one line
     text = _read_text(Path(path), where)
     try:
         data = yaml.safe_load(text)
