@@ -10,7 +10,7 @@ side). Then it counts the folders left mixed (files of both specs), corrupt, or 
 with debris (the folder beside, a staging folder, temporary files), and what ``--check`` said; then runs the
 generator again and checks all new files and no debris.
 
-    python -m bench.sidechan.generator_kills --kills 200 [--aimed 100]
+    python -m bench.sidechan.generator_kills [--kills 200] [--aimed 100]
 """
 
 from __future__ import annotations
@@ -147,7 +147,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="generator_kills")
     p.add_argument("--kills", type=int, default=200)
     p.add_argument("--seed", type=int, default=53)
-    p.add_argument("--aimed", type=int, default=0, help="and this many kills aimed at the writing phase")
+    p.add_argument("--aimed", type=int, default=100, help="and this many kills aimed at the writing phase")
     p.add_argument("--json", action="store_true", help="print the counts as JSON only, write nothing")
     args = p.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="generator-kills-") as work:

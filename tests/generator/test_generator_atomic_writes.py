@@ -177,9 +177,10 @@ def test_gitignore_covers_the_debris(path: str) -> None:
 
 
 def test_a_handful_of_real_kills_leave_nothing_mixed_and_no_debris_after_the_next_run() -> None:
-    run = subprocess.run([sys.executable, "-m", "bench.sidechan.generator_kills", "--kills", "6", "--seed", "7",
-                          "--json"], cwd=REPO, capture_output=True, text=True, check=True, timeout=600)
-    counts = json.loads(run.stdout)
-    assert counts["all_old"] + counts["all_new"] == 6, counts
-    assert counts["mixed"] == counts["corrupt"] == counts["not_new_after_next_run"] == 0, counts
-    assert counts["debris_after_next_run"] == 0, counts
+    run = subprocess.run([sys.executable, "-m", "bench.sidechan.generator_kills", "--kills", "1", "--aimed", "3",
+                          "--seed", "7", "--json"], cwd=REPO, capture_output=True, text=True, check=True, timeout=600)
+    found = json.loads(run.stdout)
+    for kills, counts in ((1, found["spread"]), (3, found["aimed"])):  # aimed: while the folder beside exists
+        assert counts["all_old"] + counts["all_new"] == kills, counts
+        assert counts["mixed"] == counts["corrupt"] == counts["other_files_lost"] == 0, counts
+        assert counts["not_new_after_next_run"] == counts["debris_after_next_run"] == 0, counts
