@@ -170,7 +170,9 @@ def exchange(a: Path, b: Path) -> bool:
     if renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0:
         return True
     err = ctypes.get_errno()
-    if err in (errno.ENOSYS, errno.EINVAL, errno.EOPNOTSUPP):  # an old kernel, a file system without it
+    # an old kernel, a file system without it, an output folder that is a mount point (or on another device
+    # than its parent folder)
+    if err in (errno.ENOSYS, errno.EINVAL, errno.EOPNOTSUPP, errno.EBUSY, errno.EXDEV):
         return False
     raise OSError(err, os.strerror(err), str(a), None, str(b))
 

@@ -7,6 +7,8 @@ covers them. A handful of real SIGKILLs too (``make bench-sidechan`` runs 200)."
 
 from __future__ import annotations
 
+import ctypes
+import errno
 import json
 import os
 import subprocess
@@ -184,3 +186,18 @@ def test_a_handful_of_real_kills_leave_nothing_mixed_and_no_debris_after_the_nex
         assert counts["all_old"] + counts["all_new"] == kills, counts
         assert counts["mixed"] == counts["corrupt"] == counts["other_files_lost"] == 0, counts
         assert counts["not_new_after_next_run"] == counts["debris_after_next_run"] == 0, counts
+
+
+@pytest.mark.parametrize("err", [errno.ENOSYS, errno.EINVAL, errno.EOPNOTSUPP, errno.EBUSY, errno.EXDEV])
+def test_an_exchange_the_system_refuses_falls_back_to_the_journalled_moves(
+    out: Path, monkeypatch: pytest.MonkeyPatch, err: int
+) -> None:
+    class Libc:
+        @staticmethod
+        def renameat2(*args: object) -> int:
+            ctypes.set_errno(err)
+            return -1
+
+    monkeypatch.setattr(ctypes, "CDLL", lambda *a, **k: Libc())
+    assert write_atomically(NEW, out) == ["a.txt", "sub/b.txt", "sub/deep/c.txt"]
+    assert _on_disk(out) == NEW and debris(out) == [] and not beside(out).exists()
