@@ -2,9 +2,10 @@
 their code was about 80 % of a first run on a fresh clone.
 
 Each ``.pyj`` file holds the code Jinja generates for one template, under a first line naming the Jinja version
-and the sha256 of the template's source and of the environment options that shape the code. A file whose line
-does not match is never used: the template is compiled in memory instead; ``python -m generator`` rewrites the
-file (``refresh``) and ``--check`` reports a set that does not match the templates (``problems``).
+and the sha256 of the template's source and of the environment options that shape the code, repeated as a value
+that the code must carry when it runs. A file that does not match is never used: the template is compiled in
+memory instead; ``python -m generator`` rewrites the file (``refresh``) and ``--check`` reports a set that does
+not match the templates (``problems``). Python keeps the files' bytecode in ``__pycache__`` as for any module.
 """
 
 from __future__ import annotations
