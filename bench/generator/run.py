@@ -166,6 +166,9 @@ def main() -> int:
         opts.results.write_text(
             "# Generator benchmarks\n\n`python bench/generator/run.py` (`make bench-generator`); medians of "
             f"{runs} runs each, wall and CPU (user + sys), the measures of each table taking turns round by round."
+            "\nCold: `python -m generator` in a copy of generator/ and spec/ with no `__pycache__`, "
+            "PYTHONDONTWRITEBYTECODE=1 and an empty HOME, as a fresh clone's first run; warm: the same copy with "
+            "the bytecode Python keeps after a first run."
             f"\n\n{table}\n\n{floor}; 1-minute load average "
             f"at the end {load:.1f}. Machine: {platform.machine()}, Python {platform.python_version()}, "
             f"{platform.system()}; shared with other jobs (2 cores).\n",
