@@ -41,6 +41,8 @@ class BuildWithFirmware(build_py):
 setup(
     packages=[f"{NAMESPACE}.{p}" for p in found],
     package_dir={f"{NAMESPACE}.{p}": p.replace(".", "/") for p in found},
-    package_data={f"{NAMESPACE}.{p}": ["py.typed", "*.j2", "**/*.j2", "*.html", "*.yaml", "LICENSE"] for p in found},
+    # *.pyj: the templates precompiled to Python (generator/precompiled.py)
+    package_data={f"{NAMESPACE}.{p}": ["py.typed", "*.j2", "**/*.j2", "*.pyj", "**/*.pyj", "*.html", "*.yaml",
+                                       "LICENSE"] for p in found},
     cmdclass={"build_py": BuildWithFirmware},
 )

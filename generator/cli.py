@@ -69,15 +69,17 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{parser.prog} {__version__} (spec {shown}: {spec.name} {spec.version}, "
               f"fingerprint {spec.short_fingerprint})")
         return 0
-    from .render import render_all  # Jinja only for a valid spec
+    from . import precompiled
+    from .render import environments, render_all  # Jinja only for a valid spec
     from .safety import report as safety_report
     from .writing import stale_files, write_atomically
 
-    files = render_all(spec)
+    envs = environments()
+    files = render_all(spec, envs)
     if opts.check:
-        for line in safety_report(spec):
+        for line in safety_report(spec) + precompiled.notes(envs):
             print(line)
-        problems = stale_files(files, opts.out)
+        problems = stale_files(files, opts.out) + precompiled.problems(envs, display_path)
         for line in problems:
             print(line)
         if problems:
@@ -95,6 +97,9 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_INVALID
     print(f"{len(files)} files from {shown} (fingerprint {spec.short_fingerprint}) in {display_path(opts.out)}/: "
           f"{len(changed)} changed")
+    refreshed = precompiled.refresh(envs)  # after edited templates, so that the next run need not compile them
+    if refreshed:
+        print(f"{len(refreshed)} precompiled template(s) rewritten in {display_path(precompiled.PRECOMPILED)}/")
     return 0
 
 

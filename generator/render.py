@@ -1,12 +1,8 @@
-"""Render every target of a spec in memory, compare with what is on disk, and write atomically."""
+"""Render every target of a spec in memory: one Jinja environment per template folder."""
 
 from __future__ import annotations
 
-import contextlib
-import functools
 import json
-import os
-from pathlib import Path
 
 import jinja2
 
@@ -15,13 +11,12 @@ from .build import FRAME_ERRORS, PARSER_ERRORS, STREAM_ERRORS
 from .diff import contract
 from .model import Spec
 from .names import pascal
+from .precompiled import TEMPLATES, PrecompiledLoader
 from .ready import build_ready_vectors, ready_rule
 from .safety import form_figures, one_byte_neighbours, safe_defaults
 from .targets import TARGETS, Target, comment_style
 from .vectors import build_vectors
 from .widths import CTYPES
-
-TEMPLATES = Path(__file__).parent / "templates"
 
 
 def header_lines(spec: Spec) -> list[str]:
@@ -42,55 +37,36 @@ def _with_header(path: str, text: str, spec: Spec) -> str:
     return "".join(f"{style} {line}\n" for line in lines) + text
 
 
-class _TemplateCache(jinja2.FileSystemBytecodeCache):
-    """Compiled templates kept between runs (compiling them is most of a run's time). Keyed by each template's
-    source checksum, so an edited template is compiled again; a cache that cannot be read or written is skipped."""
-
-    def load_bytecode(self, bucket: jinja2.bccache.Bucket) -> None:
-        try:
-            super().load_bytecode(bucket)
-        except (OSError, ValueError, EOFError):
-            bucket.reset()
-
-    def dump_bytecode(self, bucket: jinja2.bccache.Bucket) -> None:
-        with contextlib.suppress(OSError):
-            super().dump_bytecode(bucket)
-
-
-@functools.cache
-def _template_cache() -> jinja2.BytecodeCache | None:
-    if os.environ.get("DRONE_PROTOCOL_GEN_NO_CACHE"):
-        return None
-    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-    folder = base / "drone-protocol-gen" / f"jinja2-{jinja2.__version__}"
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError:
-        return None
-    return _TemplateCache(str(folder))
-
-
 def _environment(target: Target) -> jinja2.Environment:
     env = jinja2.Environment(
-        loader=jinja2.FileSystemLoader(TEMPLATES / target.name),
         undefined=jinja2.StrictUndefined,
         trim_blocks=True,
         lstrip_blocks=True,
         keep_trailing_newline=True,
         autoescape=False,
-        # Part of the compiled code: a target's options never change, and each target's templates have their
-        # own file names, which key the cache.
         finalize=filters.html_text if target.escape == "html" else None,
-        bytecode_cache=_template_cache(),
-        # No constant folding when compiling: it cost about a sixth of an uncached run's compiling, and rendering
-        # folds the same constants at no measurable cost.
+        # No constant folding when compiling: it cost about a sixth of the compiling, and rendering folds the same
+        # constants at no measurable cost.
         optimized=False,
     )
     env.filters.update(filters.ALL)
+    # What shapes each template's compiled code, so part of its precompiled file's key: the options, the
+    # finaliser, and how each filter and test is called.
+    shape = [(name, getattr(env, name)) for name in ("trim_blocks", "lstrip_blocks", "keep_trailing_newline",
+                                                      "autoescape", "optimized", "undefined", "newline_sequence")]
+    shape += [("finalize", target.escape)]
+    shape += [(f"{kind} {k}", str(getattr(f, "jinja_pass_arg", ""))) for kind, table in
+              (("filter", env.filters), ("test", env.tests)) for k, f in sorted(table.items())]
+    env.loader = PrecompiledLoader(target.name, repr(shape))
     return env
 
 
-def render_all(spec: Spec) -> dict[str, bytes]:
+def environments() -> dict[str, jinja2.Environment]:
+    """One environment per template folder."""
+    return {target.name: _environment(target) for target in TARGETS}
+
+
+def render_all(spec: Spec, envs: dict[str, jinja2.Environment] | None = None) -> dict[str, bytes]:
     """Every generated file, keyed by its path relative to the output folder."""
     names = {"{package}": spec.name, "{Library}": pascal(spec.name)}
     parameter_files = ardupilot.parameter_files(spec)
@@ -123,8 +99,9 @@ def render_all(spec: Spec) -> dict[str, bytes]:
         "license_text": (TEMPLATES / "LICENSE").read_text(encoding="utf-8"),
     }
     files: dict[str, bytes] = {}
+    envs = envs or environments()
     for target in TARGETS:
-        env = _environment(target)
+        env = envs[target.name]
         if target.name == "docs":  # the bench table reads the constants of the C++ header rendered before it
             library = pascal(spec.name)
             context["bench"] = bench.table(spec, files[f"arduino/{library}/src/{library}_spec.h"].decode("utf-8"))

@@ -1,10 +1,14 @@
-"""The generator's writing phase is all or nothing: a run cut off before its commit point leaves the old
-files, one cut off after it is finished by the next run; the next run removes any staging folder or stray
-temporary file, ``--check`` reports them, and ``.gitignore`` covers them. A handful of real SIGKILLs too
-(``make bench-sidechan`` runs 200)."""
+"""The generator's writing phase is all or nothing at every instant: the new output folder is built beside the
+old one and the two are exchanged in one step, keeping what else lived in the folder; a run cut off before the
+exchange leaves the old files, one cut off after it the new ones. Where the exchange is not supported, the
+journalled fallback: a run cut off after its commit point is finished by the next run. The next run removes
+the folder beside, any staging folder or stray temporary file; ``--check`` reports them and ``.gitignore``
+covers them. A handful of real SIGKILLs too (``make bench-sidechan`` runs 200)."""
 
 from __future__ import annotations
 
+import ctypes
+import errno
 import json
 import os
 import subprocess
@@ -13,7 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from generator.writing import MANIFEST, STAGING, debris, recover, stale_files, write_atomically
+from generator import writing
+from generator.writing import MANIFEST, STAGING, beside, debris, exchange, recover, stale_files, write_atomically
 
 REPO = Path(__file__).resolve().parents[2]
 OLD = {"a.txt": b"old a\n", "sub/b.txt": b"old b\n", "sub/deep/c.txt": b"old c\n", "same.txt": b"same\n"}
@@ -46,12 +51,80 @@ def test_a_run_cut_off_while_staging_leaves_the_old_files_and_no_staging(
     monkeypatch.setattr(Path, "write_bytes", write_bytes)
     with pytest.raises(KeyboardInterrupt):
         write_atomically(NEW, out)
-    assert _on_disk(out) == OLD and not (out / STAGING).exists()
+    assert _on_disk(out) == OLD and not (out / STAGING).exists() and not beside(out).exists()
 
 
-def test_a_run_cut_off_after_its_commit_point_is_reported_then_finished(
+def test_the_new_folder_replaces_the_old_in_one_exchange_keeping_what_else_lived_there(
     out: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    (out / "__pycache__").mkdir()
+    (out / "__pycache__" / "x.pyc").write_bytes(b"bytecode")
+    (out / "notes.txt").write_bytes(b"mine")
+    (out / "link").symlink_to("a.txt")
+    kept = {"__pycache__/x.pyc": b"bytecode", "notes.txt": b"mine", "link": NEW["a.txt"]}
+    same_inode = (out / "same.txt").stat().st_ino
+    seen = []
+
+    def watched(a: Path, b: Path) -> bool:
+        seen.append(_on_disk(b))  # the output folder just before the exchange
+        done = exchange(a, b)
+        seen.append(_on_disk(b))
+        return done
+
+    monkeypatch.setattr(writing, "exchange", watched)
+    assert write_atomically(NEW, out) == ["a.txt", "sub/b.txt", "sub/deep/c.txt"]
+    assert seen == [OLD | kept | {"link": OLD["a.txt"]}, NEW | kept]
+    assert _on_disk(out) == NEW | kept and (out / "link").is_symlink()
+    assert (out / "same.txt").stat().st_ino == same_inode  # hard-linked, not copied
+    assert not beside(out).exists() and debris(out) == []
+
+
+def test_a_run_cut_off_after_the_exchange_leaves_the_new_files_and_the_next_run_removes_the_old(
+    out: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def killed(path: Path) -> None:
+        raise SystemExit("killed")  # before the old folder, now beside, is removed
+
+    monkeypatch.setattr(writing, "_remove", killed)
+    with pytest.raises(SystemExit):
+        write_atomically(NEW, out)
+    monkeypatch.undo()
+    assert _on_disk(out) == NEW and _on_disk(beside(out)) == OLD
+    assert debris(out) == [f"debris: {beside(out)} (a run was cut off while building the new output folder or "
+                           "removing the old one; the next run removes it)"]
+    assert write_atomically(NEW, out) == [] and not beside(out).exists() and _on_disk(out) == NEW
+
+
+def test_a_half_built_folder_beside_is_reported_and_removed(out: Path) -> None:
+    (beside(out) / "sub").mkdir(parents=True)
+    (beside(out) / "sub" / "b.txt").write_bytes(NEW["sub/b.txt"])  # a run killed while building
+    assert _on_disk(out) == OLD and len(debris(out)) == 1
+    assert recover(out) == [f"removed {beside(out)}, left by a cut-off run"]
+    assert not beside(out).exists() and _on_disk(out) == OLD
+
+
+def test_exchange_swaps_two_folders_in_one_call(tmp_path: Path) -> None:
+    a, b = tmp_path / "a", tmp_path / "b"
+    a.mkdir()
+    b.mkdir()
+    (a / "x").write_bytes(b"from a")
+    (b / "y").write_bytes(b"from b")
+    assert exchange(a, b)  # Linux with glibc 2.28 or later, on a file system that supports it (tmpfs, ext4)
+    assert [p.name for p in a.iterdir()] == ["y"] and [p.name for p in b.iterdir()] == ["x"]
+
+
+def test_without_the_exchange_the_journalled_moves_write_the_new_files(
+    out: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(writing, "exchange", lambda a, b: False)
+    assert write_atomically(NEW, out) == ["a.txt", "sub/b.txt", "sub/deep/c.txt"]
+    assert _on_disk(out) == NEW and debris(out) == [] and not beside(out).exists()
+
+
+def test_a_journalled_run_cut_off_after_its_commit_point_is_reported_then_finished(
+    out: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(writing, "exchange", lambda a, b: False)
     real = os.replace
     moves = []
 
@@ -91,22 +164,40 @@ def test_check_reports_debris_in_the_real_output_folder(tmp_path: Path) -> None:
     run = [sys.executable, "-m", "generator", "--out", str(out)]
     assert subprocess.run(run, cwd=REPO, capture_output=True, check=False).returncode == 0
     (out / "python" / ".stray.py.abc.tmp").write_bytes(b"")
+    beside(out).mkdir()
     check = subprocess.run([*run, "--check"], cwd=REPO, capture_output=True, text=True, check=False)
     assert check.returncode == 1 and f"debris: {out / 'python' / '.stray.py.abc.tmp'}" in check.stdout
+    assert f"debris: {beside(out)} " in check.stdout
     assert subprocess.run(run, cwd=REPO, capture_output=True, check=False).returncode == 0
     assert subprocess.run([*run, "--check"], cwd=REPO, capture_output=True, check=False).returncode == 0
 
 
-@pytest.mark.parametrize("path", ["generated/.generator-staging/files/python/x.py", "generated/python/.x.py.k2.tmp"])
+@pytest.mark.parametrize("path", [".generated.generator-new/python/x.py",
+                                  "generated/.generator-staging/files/python/x.py", "generated/python/.x.py.k2.tmp"])
 def test_gitignore_covers_the_debris(path: str) -> None:
     assert subprocess.run(["git", "check-ignore", "-q", path], cwd=REPO, check=False).returncode == 0
 
 
 def test_a_handful_of_real_kills_leave_nothing_mixed_and_no_debris_after_the_next_run() -> None:
-    run = subprocess.run([sys.executable, "-m", "bench.sidechan.generator_kills", "--kills", "6", "--seed", "7",
-                          "--json"], cwd=REPO, capture_output=True, text=True, check=True, timeout=600)
-    counts = json.loads(run.stdout)
-    # a kill in the few milliseconds of moving files into place leaves a mix with its committed manifest
-    assert counts["all_old"] + counts["all_new"] + counts["mixed"] == 6, counts
-    assert counts["mixed_without_manifest"] == counts["corrupt"] == counts["not_new_after_next_run"] == 0, counts
-    assert counts["debris_after_next_run"] == 0, counts
+    run = subprocess.run([sys.executable, "-m", "bench.sidechan.generator_kills", "--kills", "1", "--aimed", "3",
+                          "--seed", "7", "--json"], cwd=REPO, capture_output=True, text=True, check=True, timeout=600)
+    found = json.loads(run.stdout)
+    for kills, counts in ((1, found["spread"]), (3, found["aimed"])):  # aimed: while the folder beside exists
+        assert counts["all_old"] + counts["all_new"] == kills, counts
+        assert counts["mixed"] == counts["corrupt"] == counts["other_files_lost"] == 0, counts
+        assert counts["not_new_after_next_run"] == counts["debris_after_next_run"] == 0, counts
+
+
+@pytest.mark.parametrize("err", [errno.ENOSYS, errno.EINVAL, errno.EOPNOTSUPP, errno.EBUSY, errno.EXDEV])
+def test_an_exchange_the_system_refuses_falls_back_to_the_journalled_moves(
+    out: Path, monkeypatch: pytest.MonkeyPatch, err: int
+) -> None:
+    class Libc:
+        @staticmethod
+        def renameat2(*args: object) -> int:
+            ctypes.set_errno(err)
+            return -1
+
+    monkeypatch.setattr(ctypes, "CDLL", lambda *a, **k: Libc())
+    assert write_atomically(NEW, out) == ["a.txt", "sub/b.txt", "sub/deep/c.txt"]
+    assert _on_disk(out) == NEW and debris(out) == [] and not beside(out).exists()

@@ -103,6 +103,7 @@ def test_the_project_wheel_installs_one_namespace_of_its_own(tmp_path: Path) -> 
     assert tops == {"drone_protocol_tools"}
     assert "drone_protocol_tools/generator/cli.py" in names and "drone_protocol_tools/pilot/app/cli.py" in names
     assert any(n.startswith("drone_protocol_tools/generator/templates/python/") for n in names)
+    assert "drone_protocol_tools/generator/precompiled/arduino/{Library}/src/{Library}.h.pyj" in names
     # package data: the simulator's parameters and the virtual drone's sources (nothing read from the repository)
     assert {"drone_protocol_tools/pilot/sim/arducopter.yaml", "drone_protocol_tools/pilot/sim/drone.parm",
             "drone_protocol_tools/pilot/sim/firmware/host/virtual_drone.cpp"} <= set(names)
