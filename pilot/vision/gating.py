@@ -7,13 +7,12 @@ The controller shows the gate every frame's detection (``observe``) and then ask
   aiming need this; anything less counts as a miss.
 * ``confirmed()``: may the laser be on now: the last ``controller.confirm_frames`` frames in a row were
   each measured (not bridged), acquired, centred within ``controller.fire_tolerance``, estimated closer
-  than ``controller.fire_range_max_m``, and each the same steady thing as the frame before: its size within
-  ``STEADY_SIZE`` and its centre within ``STEADY_STEP`` of its size (a hovering drone's ball changes little
-  from one frame to the next; a film's patches come, go, and the track's best candidate hops between them).
+  than ``controller.fire_range_max_m``, and the same steady thing as the frame before (``steady``: a hovering
+  drone's ball changes little from frame to frame; a film's patches come and go, the track hopping between them).
 
 A bad frame (``FrameStatus`` other than OK) is never a sighting and breaks the confirmation; ``fault`` and
-``fault_frames`` tell the controller to hold and, after ``controller.blind_frames`` of them, to land.
-The figures behind the laser's rules: bench/vision/HISTORY.md ("Thirty-fifth session").
+``fault_frames`` tell the controller to hold and, after ``controller.blind_frames`` of them, to land. Figures:
+bench/vision/HISTORY.md ("Thirty-fifth session").
 """
 
 from __future__ import annotations
