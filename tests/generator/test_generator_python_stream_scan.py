@@ -99,3 +99,30 @@ def test_category_bytes_in_garbage_are_counted_without_problem(monkeypatch: pyte
     assert [c.name for c in out] == [dp.CommandName.ARM] and pending == b""
     assert errors[dp.ErrorKind.BAD_DIRECTION] == 50 and errors[dp.ErrorKind.BAD_CATEGORY] == 50
     assert calls == []
+
+
+def test_the_separator_byte_inside_garbage_does_not_misplace_a_pair() -> None:
+    """The pieces of garbage are searched joined by _SEP; a _SEP byte inside the garbage itself (after a category,
+    and before a category and one of its directions) must not shift where problem() looks."""
+    sep = dp_stream._SEP
+    category = next(iter(dp.codec.BY_BYTES))
+    direction = next(iter(dp.codec.BY_BYTES[category]))
+    arm = dp.command_frame(dp.CommandName.ARM)
+    pair = bytes([category, direction]) + b"x"
+    data = b"".join([sep, bytes([category]) + sep + sep, arm, sep * 3 + pair, arm, pair + sep, arm, sep + pair])
+    assert scanned(data) == reference(data)
+    assert scanned(data)[1][dp.ErrorKind.BAD_DIGIT] == 3  # the three pairs
+
+
+def test_a_category_before_a_frame_whose_first_byte_is_its_direction() -> None:
+    """Garbage ending in a category, followed by a frame whose category byte is one of that category's directions
+    (m then l, laser's category, a direction of move): a pair, and problem() names its bad digit."""
+    edges = [(c, d) for c, table in dp.codec.BY_BYTES.items() for d in table if d in dp.codec.BY_BYTES]
+    assert edges, "the shipped spec has a category that is a direction of another"
+    for category, direction in edges:
+        frame = next(dp.command_frame(s.name, s.default if s.default is not None else s.minimum)
+                     for s in dp.COMMANDS.values() if s.prefix[0] == direction)
+        arm = dp.command_frame(dp.CommandName.ARM)
+        data = b"\xff" + arm + b"\xfe" + bytes([category]) + frame + arm
+        dp.codec.DECODED.clear()
+        assert scanned(data) == reference(data), data
