@@ -4,6 +4,7 @@ start is one error of the kind problem() names, and the valid start of a frame a
 
 from __future__ import annotations
 
+import itertools
 import random
 
 import drone_protocol as dp
@@ -126,3 +127,22 @@ def test_a_category_before_a_frame_whose_first_byte_is_its_direction() -> None:
         data = b"\xff" + arm + b"\xfe" + bytes([category]) + frame + arm
         dp.codec.DECODED.clear()
         assert scanned(data) == reference(data), data
+
+
+def test_the_memo_of_frames_stays_bounded_whatever_the_chunk() -> None:
+    """The stream checks the memo's bound once a chunk: a chunk of more new frames than it holds decodes them all
+    and leaves the memo no larger than its bound; smaller chunks fill it up to the bound, then it starts over."""
+    bound = dp.codec._DECODED_MAX
+    every = (dp.command_frame(s.name, v) for s in dp.COMMANDS.values() for v in range(s.minimum, s.maximum + 1))
+    frames = list(itertools.islice(every, 2 * bound + 10))
+    assert len(frames) == 2 * bound + 10, "the spec has too few distinct frames"
+    dp.codec.DECODED.clear()
+    big = b"".join(frames[:bound + 10])
+    assert [c.encode() for c in dp.StreamDecoder().feed(big, 0.0)] == frames[:bound + 10]
+    assert len(dp.codec.DECODED) <= bound
+    decoder = dp.StreamDecoder()
+    sizes = []
+    for i in range(0, 2 * bound, 100):
+        assert [c.encode() for c in decoder.feed(b"".join(frames[i:i + 100]), 0.0)] == frames[i:i + 100]
+        sizes.append(len(dp.codec.DECODED))
+    assert max(sizes) <= bound and sizes.index(max(sizes)) < len(sizes) - 1  # filled, then started over
