@@ -4,6 +4,7 @@ start is one error of the kind problem() names, and the valid start of a frame a
 
 from __future__ import annotations
 
+import itertools
 import random
 
 import drone_protocol as dp
@@ -99,3 +100,49 @@ def test_category_bytes_in_garbage_are_counted_without_problem(monkeypatch: pyte
     assert [c.name for c in out] == [dp.CommandName.ARM] and pending == b""
     assert errors[dp.ErrorKind.BAD_DIRECTION] == 50 and errors[dp.ErrorKind.BAD_CATEGORY] == 50
     assert calls == []
+
+
+def test_the_separator_byte_inside_garbage_does_not_misplace_a_pair() -> None:
+    """The pieces of garbage are searched joined by _SEP; a _SEP byte inside the garbage itself (after a category,
+    and before a category and one of its directions) must not shift where problem() looks."""
+    sep = dp_stream._SEP
+    category = next(iter(dp.codec.BY_BYTES))
+    direction = next(iter(dp.codec.BY_BYTES[category]))
+    arm = dp.command_frame(dp.CommandName.ARM)
+    pair = bytes([category, direction]) + b"x"
+    data = b"".join([sep, bytes([category]) + sep + sep, arm, sep * 3 + pair, arm, pair + sep, arm, sep + pair])
+    assert scanned(data) == reference(data)
+    assert scanned(data)[1][dp.ErrorKind.BAD_DIGIT] == 3  # the three pairs
+
+
+def test_a_category_before_a_frame_whose_first_byte_is_its_direction() -> None:
+    """Garbage ending in a category, followed by a frame whose category byte is one of that category's directions
+    (m then l, laser's category, a direction of move): a pair, and problem() names its bad digit."""
+    edges = [(c, d) for c, table in dp.codec.BY_BYTES.items() for d in table if d in dp.codec.BY_BYTES]
+    assert edges, "the shipped spec has a category that is a direction of another"
+    for category, direction in edges:
+        frame = next(dp.command_frame(s.name, s.default if s.default is not None else s.minimum)
+                     for s in dp.COMMANDS.values() if s.prefix[0] == direction)
+        arm = dp.command_frame(dp.CommandName.ARM)
+        data = b"\xff" + arm + b"\xfe" + bytes([category]) + frame + arm
+        dp.codec.DECODED.clear()
+        assert scanned(data) == reference(data), data
+
+
+def test_the_memo_of_frames_stays_bounded_whatever_the_chunk() -> None:
+    """The stream checks the memo's bound once a chunk: a chunk of more new frames than it holds decodes them all
+    and leaves the memo no larger than its bound; smaller chunks fill it up to the bound, then it starts over."""
+    bound = dp.codec._DECODED_MAX
+    every = (dp.command_frame(s.name, v) for s in dp.COMMANDS.values() for v in range(s.minimum, s.maximum + 1))
+    frames = list(itertools.islice(every, 2 * bound + 10))
+    assert len(frames) == 2 * bound + 10, "the spec has too few distinct frames"
+    dp.codec.DECODED.clear()
+    big = b"".join(frames[:bound + 10])
+    assert [c.encode() for c in dp.StreamDecoder().feed(big, 0.0)] == frames[:bound + 10]
+    assert len(dp.codec.DECODED) <= bound
+    decoder = dp.StreamDecoder()
+    sizes = []
+    for i in range(0, 2 * bound, 100):
+        assert [c.encode() for c in decoder.feed(b"".join(frames[i:i + 100]), 0.0)] == frames[i:i + 100]
+        sizes.append(len(dp.codec.DECODED))
+    assert max(sizes) <= bound and sizes.index(max(sizes)) < len(sizes) - 1  # filled, then started over

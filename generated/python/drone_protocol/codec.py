@@ -138,11 +138,15 @@ def complete(frames: list[bytes], commands: list[Command | None]) -> int:
     """Fill in the None entries of `commands` (DECODED's answers for `frames`, frame-shaped bytes of WIRE_LENGTH:
     digits where the value goes) with valid()'s, written out: a call per frame cost more than its body. Return the
     index of the first frame that is not valid, or len(frames)."""
-    k = commands.index(None)
-    try:
-        while True:
+    first = commands.index(None)
+    missing = commands.count(None)
+    if len(DECODED) + missing > _DECODED_MAX:  # the memo's bound, checked once for the chunk
+        DECODED.clear()
+    memo = DECODED if missing <= _DECODED_MAX else {}  # more new frames than it holds: remembered for this chunk
+    for k in range(first, len(frames)):  # a loop step per frame cost less than an index() call per new one
+        if commands[k] is None:
             frame = frames[k]
-            command = DECODED.get(frame)  # a repeat of a frame decoded earlier in this data
+            command = memo.get(frame)  # a repeat of a frame decoded earlier in this data
             if command is None:
                 fields = _FIELDS[frame[0]][frame[1]]
                 if fields is None:
@@ -151,14 +155,9 @@ def complete(frames: list[bytes], commands: list[Command | None]) -> int:
                 category, direction, name, minimum, maximum = fields
                 if not minimum <= value <= maximum:
                     return k
-                command = _new(Command, (category, direction, value, name))
-                if len(DECODED) >= _DECODED_MAX:
-                    DECODED.clear()
-                DECODED[frame] = command
+                command = memo[frame] = _new(Command, (category, direction, value, name))
             commands[k] = command
-            k = commands.index(None, k + 1)
-    except ValueError:  # no None left
-        return len(frames)
+    return len(frames)
 
 
 def problem(data: bytes, start: int, length: int) -> tuple[ErrorKind, int] | None:

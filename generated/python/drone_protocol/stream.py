@@ -8,6 +8,8 @@ from __future__ import annotations
 import re
 import time
 from collections.abc import Callable, Iterable, Mapping
+from functools import cache
+from itertools import accumulate
 from types import MappingProxyType
 
 from .codec import BY_BYTES, DECODED, BytesLike, Command, complete, problem, valid
@@ -16,7 +18,17 @@ from .tables import FRAME_LENGTH, INTER_BYTE_TIMEOUT_MS, WIRE_LENGTH, ErrorKind
 
 
 def _any_of(codes: Iterable[int]) -> bytes:
-    return b"[" + b"".join(re.escape(bytes([c])) for c in sorted(codes)) + b"]"
+    """A class of these bytes, runs of three or more as ranges: `[a-z]`, where 26 bytes cost re 26 items to parse."""
+    out: list[list[int]] = []
+    run: list[int] = []
+    for c in sorted(codes):
+        if run and c != run[-1] + 1:
+            out.append(run)
+            run = []
+        run.append(c)
+    out.append(run)
+    return b"[" + b"".join(re.escape(bytes([r[0]])) + b"-" + re.escape(bytes([r[-1]])) if len(r) > 2 else
+                           b"".join(re.escape(bytes([c])) for c in r) for r in out if r) + b"]"
 
 
 
@@ -26,10 +38,12 @@ _PAIR = b"|".join(re.escape(bytes([c])) + _any_of(d) for c, d in BY_BYTES.items(
 # Frame-shaped bytes: a category, one of its directions, digits. Splitting the data at them gives
 # the garbage before each, the frames and the rest at C speed; the frames are then checked.
 _SHAPE = re.compile(b"((?:" + _PAIR + b")" + b"[0-9]" * (FRAME_LENGTH - 2) + b")")
-# At each category byte, an empty match where one of its directions follows, the byte itself where none does:
-# garbage is counted by kind at C speed, whatever its length and the number of categories.
-_STARTS = b"|".join(re.escape(bytes([c])) + b"(?=" + _any_of(d) + b")" for c, d in BY_BYTES.items())
-_KINDS = re.compile(_STARTS + b"|(" + _any_of(BY_BYTES) + b")")
+# Garbage is counted by kind at C speed: every byte not a category is a bad category (bytes.translate() deletes
+# the categories), every category a bad direction unless one of its directions follows; only there does problem()
+# say more. The garbage before the frames of a chunk is searched as one, each piece followed by _SEP, a byte that is
+# neither a category nor a direction.
+_CATEGORIES = bytes(BY_BYTES)
+_SEP = bytes([min(set(range(256)).difference(BY_BYTES, *BY_BYTES.values()))])
 _BAD_CATEGORY, _BAD_DIRECTION = ErrorKind.BAD_CATEGORY, ErrorKind.BAD_DIRECTION
 # Pending lengths at which a byte is a value digit that completes nothing, and the one at which a byte
 # completes the wire frame.
@@ -136,24 +150,16 @@ class StreamDecoder:
         last = garbage.pop()
         if not any(garbage):  # no garbage between the frames kept
             i = kept * WIRE_LENGTH
-        else:  # _count() of each piece, written out: the call cost more than its body
-            i = bad_category = bad_direction = 0
-            kinds = _KINDS.findall
-            for before in garbage:
-                if before:
-                    end = i + len(before)
-                    starts = kinds(data, i, end + 1)
-                    categories = len(starts) - 1  # the last is the frame's category, its direction out of sight
-                    pairs = starts.count(b"")
-                    bad_category += end - i - categories
-                    bad_direction += categories - pairs
-                    if pairs:
-                        self._pairs(data, i, end)
-                    i = end
-                i += WIRE_LENGTH
+        else:  # the pieces, searched as one: a few calls at C speed, whatever their number
+            joined = _SEP.join(garbage) + _SEP
+            total = len(joined) - len(garbage)
+            categories = len(joined) - len(joined.translate(None, _CATEGORIES))
             errors = self._errors
-            errors[_BAD_CATEGORY] += bad_category
-            errors[_BAD_DIRECTION] += bad_direction
+            errors[_BAD_CATEGORY] += total - categories
+            errors[_BAD_DIRECTION] += categories
+            if categories:
+                self._recount(data, joined, garbage)
+            i = total + kept * WIRE_LENGTH
         if kept < len(frames):  # frame-shaped, but out of range: one error at its start, then byte by byte
             if last:
                 self._count(data, i, i + len(last))
@@ -205,21 +211,41 @@ class StreamDecoder:
         """Count one error per start position in data[start:end], where no frame starts, by kind (data[end]
         exists: a direction is looked for after each category byte)."""
         errors = self._errors
-        kinds = _KINDS.findall(data, start, end + 1)
-        pairs = kinds.count(b"")
-        categories = len(kinds) - (data[end] in BY_BYTES)  # data[end] is matched, its direction out of sight
+        categories = end - start - len(data[start:end].translate(None, _CATEGORIES))
         errors[_BAD_CATEGORY] += end - start - categories
-        errors[_BAD_DIRECTION] += categories - pairs
-        if pairs:
-            self._pairs(data, start, end)
+        errors[_BAD_DIRECTION] += categories
+        if categories:
+            for candidate in _candidates().finditer(data, start, end + 1):  # _SEP there is no direction
+                errors[_BAD_DIRECTION] -= 1
+                errors[_kind(data, candidate.start())] += 1
 
-    def _pairs(self, data: bytes, start: int, end: int) -> None:
-        """Count the error at each start in data[start:end] where a category and one of its directions are not
-        followed by a frame: problem() says what is wrong."""
+    def _recount(self, data: bytes, joined: bytes, garbage: list[bytes]) -> None:
+        """Recount each category of `joined` (the pieces of garbage before the frames of `data`, each followed by
+        _SEP) that _candidates() finds: problem() at its place in `data` says what is wrong there."""
         errors = self._errors
-        for start_of in _KINDS.finditer(data, start, end + 1):
-            if start_of.group(1) is None:  # an empty match: a category and one of its directions
-                errors[_kind(data, start_of.start())] += 1
+        ends = list(accumulate(map(len, garbage)))
+        piece = 0
+        for candidate in _candidates().finditer(joined):
+            at = candidate.start()
+            while at >= ends[piece] + piece:  # the piece holding it: _SEP may be a byte of the garbage too
+                piece += 1
+            errors[_BAD_DIRECTION] -= 1
+            errors[_kind(data, at + (WIRE_LENGTH - 1) * piece)] += 1
+
+
+@cache  # built at the first garbage, not at import: compiling it cost about 3 % of the package's import
+def _candidates() -> re.Pattern[bytes]:
+    """Where to look closer: a category and one of its directions, or _SEP where a category is one of its
+    directions (the frame's first byte follows the piece). One alternative per category, each starting with its
+    byte: the engine skips the other bytes."""
+    classes: dict[frozenset[int], bytes] = {}  # one class per set of directions (one for a 26x26 spec)
+    alternatives = []
+    for c, d in BY_BYTES.items():
+        followers = frozenset(d).union(_SEP if set(d) & set(BY_BYTES) else b"")
+        if followers not in classes:
+            classes[followers] = _any_of(followers)
+        alternatives.append(re.escape(bytes([c])) + b"(?=" + classes[followers] + b")")
+    return re.compile(b"|".join(alternatives))
 
 
 def _kind(data: bytes, start: int) -> ErrorKind:
