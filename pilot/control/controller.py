@@ -20,7 +20,7 @@ import drone_protocol as dp
 
 from ..common.config import ControllerConfig
 from ..vision.detection import Detection
-from ..vision.gating import Gate
+from ..vision.gating import Gate, centred
 from .approach import ClosingSpeed, Lead, Lean, Momentum, allowed_speed
 from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, turn_towards
 from .response import TurnResponse, turn_sense
@@ -37,6 +37,9 @@ RETURN_TOL_M = 0.05  # a search's return to the height the target was seen from 
 RETURN_MAX_MS = 3000  # ... or this long after the search began
 TRIMMED = FLYING - {State.TAKEOFF}  # the states that lean against the drift (the take-off's climb takes every frame)
 HELD = frozenset({State.ACQUIRE, State.AIM, State.FIRE})  # no approach commanded: the closing speed is drift
+# AIM fires, and FIRE holds, only within this share of the fire range: a ball 10 % bigger than configured reads
+# 10 % nearer, and the drone drifts while it fires
+FIRE_RANGE_SHARE = 0.8
 PITCH_CALM_MS = 1500  # ... once the pilot's own pitch has been neutral this long (a brake's lean and speed gone)
 
 
@@ -316,8 +319,8 @@ class Controller(ControllerCore):
         if det is None or not self._found(det):
             return self._emit(dp.hold_altitude())
         self._remember_side(det)
-        if det.relative_size < self.cfg.retreat_size:
-            self._go(State.TRACK, f"target receded (size {det.relative_size:.3f})")
+        if self._too_far(det):
+            self._go(State.TRACK, f"target receded (size {det.relative_size:.3f}, {det.range_m:.2f} m)")
             return self._on_track(det)
         if det.relative_size > self.cfg.back_off_size:
             # coasted in too close (a lock lost on the way): a landing from here comes down on the target's
@@ -347,6 +350,12 @@ class Controller(ControllerCore):
             return self._laser(True)
         return self._emit(dp.hold_altitude())
 
+    def _too_far(self, det: Detection) -> bool:
+        """Too far to fire and hold the spot: smaller than ``retreat_size``, or further than ``FIRE_RANGE_SHARE``
+        of ``fire_range_max_m`` (the range's estimate errs with the target's true size, and the drone drifts)."""
+        far = det.range_m > FIRE_RANGE_SHARE * self.cfg.fire_range_max_m
+        return det.relative_size < self.cfg.retreat_size or far
+
     def _on_fire(self, det: Detection | None) -> bytes | None:
         lit_now = self.lit_ms
         if lit_now < self.cfg.fire_ms and self._now() - self._fire_started_ms >= 4 * self.cfg.fire_ms:
@@ -367,12 +376,14 @@ class Controller(ControllerCore):
             return off if off is not None else self._emit(dp.hold_altitude())
         self._misses = 0
         self._remember_side(det)
-        loose = 2.0 * self.cfg.aim_tolerance
-        far = det.relative_size < self.cfg.retreat_size  # drifted back out of range (AIM approaches again)
+        far = self._too_far(det)  # drifted back out of range (AIM approaches again)
+        near = det.relative_size > self.cfg.back_off_size  # coasting into it (AIM backs off)
         blocked = det.aim_on_target is False  # something in front of the target, where the ray goes
-        if far or blocked or abs(det.error_x) > loose or abs(det.error_y) > loose:
+        # off centre: the spot about to leave the target (the gate's room: the tolerance, or half its radius)
+        if far or near or blocked or not centred(det, self.cfg.fire_tolerance):
             off = self._laser(False)
-            why = "out of range" if far else ("something in front of the target" if blocked else "off centre")
+            why = ("out of range" if far else "too close" if near else
+                   "something in front of the target" if blocked else "off centre")
             self._go(State.AIM, f"{why} while firing")
             return off if off is not None else self._on_aim(det)
         if not self.gate.confirmed():  # vision gate: found, but not confirmed in enough frames in a row
@@ -382,9 +393,10 @@ class Controller(ControllerCore):
         on = self._laser(True)
         if on is not None:
             return on
-        # still within the loose tolerance: keep centring it (a drifting drone), the laser stays on
-        correction = self._servo_correction(det)
-        if correction is not None:
-            return correction
+        # still on the target: hold the range first (a closing speed carries the drone into it), else keep centring
+        # it (a drifting drone); the laser stays on
         hold = self._hold_range(det)
-        return hold if hold is not None else self._emit(dp.hold_altitude())
+        if hold is not None:
+            return hold
+        correction = self._servo_correction(det)
+        return correction if correction is not None else self._emit(dp.hold_altitude())
