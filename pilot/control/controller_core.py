@@ -94,6 +94,7 @@ class ControllerCore:
         self.last_command: bytes | None = None
         self.polling = False  # this tick's frame is a status poll (the runner sends it more than once)
         self._entered_ms = self._now()
+        self._land_clock_ms = self._now()  # LAND's time limit counts from here (the firmware's routine's start)
         self._hits = 0
         self._misses = 0
         self._centred = 0
@@ -122,7 +123,7 @@ class ControllerCore:
         if new is State.SEARCH and self.state is not State.ACQUIRE:
             self._search_started_ms = self._now()  # a sighting that is not confirmed does not restart the sweep
         self.state = new
-        self._entered_ms = self._now()
+        self._entered_ms = self._land_clock_ms = self._now()
         self._sent_entry = False
         self._hits = 0 if new is State.SEARCH else self._hits
         self._misses = 0
@@ -218,7 +219,7 @@ class ControllerCore:
         """One frame's decision. ``det`` is None when there is no frame this tick."""
         self._account()
         self.polling = False
-        if self.state is State.LAND and (self._elapsed() >= self.cfg.land_ms or self.gave_up):
+        if self.state is State.LAND and (self._now() - self._land_clock_ms >= self.cfg.land_ms or self.gave_up):
             # stop sending: the firmware's failsafe (laser off, failsafe throttle) takes over
             self._go(State.DONE, f"drone did not confirm it disarmed ({self.drone.describe()})")
             return None
