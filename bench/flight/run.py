@@ -90,7 +90,10 @@ def held_out(args: argparse.Namespace) -> int:
                                  args.first_seed)
             campaign(todo, args.processes, log)
     rows = [json.loads(line) for line in log.read_text().splitlines() if line.strip()]
-    base = LOG.with_name("held-out.jsonl")
+    # the same seeds at the shipped step: the HSV log of the same first seed, else the whole held-out campaign's
+    from_seed = f"-from{args.first_seed}" if args.first_seed else ""
+    base = next((path for path in (LOG.with_name(f"held-out{from_seed}-hsv.jsonl"), LOG.with_name("held-out.jsonl"))
+                 if path.is_file()), LOG.with_name("held-out.jsonl"))
     steps = sorted({int(r.get("step_us", 0)) for r in rows})
     text = "\n".join([
         f"# Strict campaign on held-out seeds{f' with speeds.step_us {args.step_us}' if args.step_us else ''}", "",

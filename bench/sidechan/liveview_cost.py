@@ -1,22 +1,13 @@
 """What the live view costs the flight loop, apart from what a crowd of clients costs the machine.
 
-The machine's load moves by tens of per cent within a minute, so flights of one condition against flights of
-another measure the machine. Here one flight carries all three conditions in turns of ``--phase`` seconds, in a
-new random order each cycle: two swarms of 300 clients (bench.sidechan.swarm, 75 each: viewers, idle, slow,
-resetting; their own processes at nice 19) are started, one on the pilot's live view and one on a decoy live view
-in another process (fed frames of the same size at 20 Hz), and are held (SIGSTOP) and resumed (SIGCONT) so that
-in each turn at most one of them runs:
-
-* ``pilot``  the swarm on the pilot's view runs: the pilot's process serves 300 clients;
-* ``decoy``  the swarm on the decoy runs: the machine carries the same crowd, the pilot's process serves nobody;
-* ``none``   both are held.
-
-``pilot`` against ``decoy`` is what serving costs the loop (the server thread's processor time and its share of
-the interpreter lock); ``decoy`` against ``none`` is what 300 clients' processes cost two shared cores. Per
-condition: the rate, the tick period's p50/p99/max, the time the loop spends in the view's ``on_tick``, how late
-the pacing's sleep wakes (the lock and the scheduler), the main thread's processor time per tick, the server
-thread's and the swarm's processor time; per cycle, the rate ratio pilot/decoy (its median and quartiles say how
-far the figure can be trusted); and the pilot process's peak memory, tracebacks, the load average.
+Flights of one condition against flights of another measure the machine's moving load, so one flight carries three
+conditions in turns of ``--phase`` seconds, in a new random order each cycle. Two swarms of 300 clients
+(bench.sidechan.swarm, nice 19), one on the pilot's live view and one on a decoy view in another process, are
+held (SIGSTOP) and resumed (SIGCONT) so that at most one runs: ``pilot`` (the pilot serves 300 clients), ``decoy``
+(the machine carries the same crowd, the pilot serves nobody), ``none`` (both held). ``pilot`` against ``decoy``
+is what serving costs the loop; ``decoy`` against ``none`` is what the clients cost two shared cores. Reported per
+condition: rate, tick period p50/p99/max, time in ``on_tick``, sleep lateness, thread and swarm CPU; per cycle the
+ratio pilot/decoy with its quartiles; peak memory, tracebacks, load average.
 
     PILOT_VIRTUAL_DRONE=build/firmware/host/virtual_drone python -m bench.sidechan.liveview_cost
 """

@@ -191,6 +191,7 @@ def fly(
                 aim_point="marker" if cfg.detector == "aruco" else "ball",
                 lose_camera_at_s=lose_camera_at_s,
                 fault=CameraFault.parse(fault) if fault else None,
+                reach_m=cfg.controller.fire_range_max_m,  # the mission's reach: a stay counts within it
             ) as world,
         ):
 

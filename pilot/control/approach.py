@@ -124,3 +124,8 @@ class Lead:
     def speed(self) -> float:
         """m/s forward the recent pitch commands added."""
         return self.accel_per_step * sum(d * s for d, s in self._steps)
+
+
+def brake_steps(speed: float) -> float:
+    """The pitch-back stick, in control steps, against a closing speed: harder the faster it closes, up to 1.4."""
+    return min(1.4, 0.8 + speed)

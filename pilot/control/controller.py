@@ -20,10 +20,12 @@ import drone_protocol as dp
 
 from ..common.config import ControllerConfig
 from ..vision.detection import Detection
-from ..vision.gating import Gate
-from .approach import ClosingSpeed, Lead, Lean, Momentum, allowed_speed
+from ..vision.gating import Gate, centred
+from .approach import ClosingSpeed, Lead, Lean, Momentum, allowed_speed, brake_steps
 from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, turn_towards
+from .descent import DESCENT_STEPS, Descent
 from .response import TurnResponse, turn_sense
+from .search import return_sense, sweep_sense
 from .sticks import HeldSticks
 from .trim import DriftHold
 from .vertical import Height, SeenFrom
@@ -33,16 +35,12 @@ __all__ = ["FLYING", "LOCKED", "Controller", "State", "Transition"]
 HOLD_MPS = 0.12  # closing speeds within this are left alone near the target (the estimate's noise)
 VIEW_EDGE = 0.9  # a brake's lean keeps the target's lower edge above this share of the frame's lower half
 MIN_BRAKE = 0.4  # control steps: the gentlest brake, whatever the view allows
-RETURN_TOL_M = 0.05  # a search's return to the height the target was seen from ends this close to it
-RETURN_MAX_MS = 3000  # ... or this long after the search began
 TRIMMED = FLYING - {State.TAKEOFF}  # the states that lean against the drift (the take-off's climb takes every frame)
 HELD = frozenset({State.ACQUIRE, State.AIM, State.FIRE})  # no approach commanded: the closing speed is drift
+# AIM fires, and FIRE holds, only within this share of the fire range: a ball 10 % bigger than configured reads
+# 10 % nearer, and the drone drifts while it fires
+FIRE_RANGE_SHARE = 0.8
 PITCH_CALM_MS = 1500  # ... once the pilot's own pitch has been neutral this long (a brake's lean and speed gone)
-
-
-def _brake_steps(speed: float) -> float:
-    """The pitch-back stick, in control steps, against a closing speed: harder the faster it closes, up to 1.4."""
-    return min(1.4, 0.8 + speed)
 
 
 class Controller(ControllerCore):
@@ -71,6 +69,7 @@ class Controller(ControllerCore):
         self._brake_speed = 0.0
         self.drift = DriftHold(self.pulses, self.cfg.unit_lean_deg)
         self._pitch_calm_ms = self._now()
+        self.descent = Descent(self.cfg.climb_mps_per_step)  # LAND's own descent, before the firmware's routine
 
     def _hold_range(self, det: Detection) -> bytes | None:
         """Near the target nothing holds position but the pilot: brake a closing speed, nudge forward against a
@@ -90,7 +89,7 @@ class Controller(ControllerCore):
     def _brake(self, speed: float, det: Detection | None = None) -> bytes:
         """Pitch back against a closing speed (``_brake_steps``), with the target in view no harder than keeps it in
         the frame (the nose comes up with the brake, see ``_brake_room``)."""
-        frac = _brake_steps(speed)
+        frac = brake_steps(speed)
         if det is not None and det.found:
             frac = max(MIN_BRAKE, min(frac, self._brake_room(det)))
         return self._emit(dp.move_backward(self._speed(dp.CommandName.MOVE_BACKWARD, frac)))
@@ -178,12 +177,10 @@ class Controller(ControllerCore):
         if self._pan_offset or self._tilt_offset:
             self._pan_offset = self._tilt_offset = 0
             return self._emit(dp.servo_reset())
-        back = self._return_step()
-        if back is not None:
-            return self._emit(back)
-        step = self._search_step(self._now() - self._search_started_ms)
-        if step is not None:
-            return self._emit(step)
+        sense = self._height_move()
+        if sense:
+            return self._emit(dp.move_up(self._speed(dp.CommandName.MOVE_UP, 1.0)) if sense > 0 else
+                              dp.move_down(self._speed(dp.CommandName.MOVE_DOWN, 1.0)))
         if self._search_sign > 0:
             return self._emit(dp.turn_right(self._speed(dp.CommandName.TURN_RIGHT, 1.0)))
         return self._emit(dp.turn_left(self._speed(dp.CommandName.TURN_LEFT, 1.0)))
@@ -192,35 +189,36 @@ class Controller(ControllerCore):
         if new is State.SEARCH and self.state is not State.SEARCH:
             self.seen_from.lost(self.height.m)
             self._return_m = self.seen_from.return_to()
+        if new is State.LAND and self.state in FLYING:
+            self.descent.begin(self._now(), self.height.m, self.drone.state)
         super()._go(new, reason)
 
-    def _return_step(self) -> bytes | None:
-        """Before sweeping, back to the height the target was last seen from (a climb may have hidden it)."""
-        if self._return_m is None:
-            return None
-        off = self._return_m - self.height.settles_m
-        if abs(off) <= RETURN_TOL_M or self._elapsed() > RETURN_MAX_MS:
-            self._return_m = None
-            return None
-        if off > 0.0:
-            return dp.move_up(self._speed(dp.CommandName.MOVE_UP, 1.0))
-        return dp.move_down(self._speed(dp.CommandName.MOVE_DOWN, 1.0))
+    def abort(self, reason: str) -> None:
+        """A stop (the user's, or an error): the firmware's landing routine at once, no descent of the pilot's."""
+        super().abort(reason)
+        self.descent.cancel()
 
-    def _search_step(self, elapsed_ms: int) -> bytes | None:
-        """The height change due this far into the sweep (None: turn): after each leg one step down, then two
-        up, two down..., so the legs sweep at the start height, one step below it, one above it..."""
-        leg, step = self.cfg.search_leg_ms, self.cfg.search_step_ms
-        t, k = elapsed_ms, 0
-        while t >= leg:
-            t -= leg
-            moving = step if k == 0 else 2 * step
-            if t < moving:
-                if k % 2 == 0:
-                    return dp.move_down(self._speed(dp.CommandName.MOVE_DOWN, 1.0))
-                return dp.move_up(self._speed(dp.CommandName.MOVE_UP, 1.0))
-            t -= moving
-            k += 1
-        return None
+    def _on_land(self, det: Detection | None) -> bytes | None:
+        """Down to ``LAND_FROM_M`` under the pilot's own sticks first (the laser off and the servos home before),
+        then the firmware's landing routine (``ControllerCore._on_land``), whose time limit starts then."""
+        if self.descent.active:
+            if self._emergency or self.descent.over(self._now(), self.height.settles_m, self.drone.state):
+                self.descent.cancel()
+                self._land_clock_ms = self._now()
+            elif self.want_laser or self.drone.laser or self._pan_offset or self._tilt_offset:
+                return super()._on_land(det)  # laser off, servos home: the core's first steps
+            else:
+                return self._emit(dp.move_down(self._speed(dp.CommandName.MOVE_DOWN, DESCENT_STEPS)))
+        return super()._on_land(det)
+
+    def _height_move(self) -> int:
+        """The search's climb (+1) or descent (-1), or 0 (turn): back to where it was seen first (``search.py``)."""
+        if self._return_m is not None:
+            sense = return_sense(self._return_m, self.height.settles_m, self._elapsed())
+            if sense:
+                return sense
+            self._return_m = None
+        return sweep_sense(self._now() - self._search_started_ms, self.cfg.search_leg_ms, self.cfg.search_step_ms)
 
     def _lost(self, det: Detection | None, limit: int) -> bool:
         if self._found(det):
@@ -239,7 +237,7 @@ class Controller(ControllerCore):
         if closing > 0.15:
             # as long as that brake takes to stop it (plus the lean's lag), not longer: a brake held on flies the
             # drone backwards into whatever is behind it, where the camera does not look
-            decel = self.cfg.pitch_accel_mps2 * _brake_steps(closing)
+            decel = self.cfg.pitch_accel_mps2 * brake_steps(closing)
             self._brake_until_ms = self._now() + round(1000.0 * (closing / decel + self.lean.lag_s))
             self._brake_speed = closing
         self._go(State.SEARCH, reason)
@@ -316,8 +314,8 @@ class Controller(ControllerCore):
         if det is None or not self._found(det):
             return self._emit(dp.hold_altitude())
         self._remember_side(det)
-        if det.relative_size < self.cfg.retreat_size:
-            self._go(State.TRACK, f"target receded (size {det.relative_size:.3f})")
+        if self._too_far(det):
+            self._go(State.TRACK, f"target receded (size {det.relative_size:.3f}, {det.range_m:.2f} m)")
             return self._on_track(det)
         if det.relative_size > self.cfg.back_off_size:
             # coasted in too close (a lock lost on the way): a landing from here comes down on the target's
@@ -347,6 +345,12 @@ class Controller(ControllerCore):
             return self._laser(True)
         return self._emit(dp.hold_altitude())
 
+    def _too_far(self, det: Detection) -> bool:
+        """Too far to fire and hold the spot: smaller than ``retreat_size``, or further than ``FIRE_RANGE_SHARE``
+        of ``fire_range_max_m`` (the range's estimate errs with the target's true size, and the drone drifts)."""
+        far = det.range_m > FIRE_RANGE_SHARE * self.cfg.fire_range_max_m
+        return det.relative_size < self.cfg.retreat_size or far
+
     def _on_fire(self, det: Detection | None) -> bytes | None:
         lit_now = self.lit_ms
         if lit_now < self.cfg.fire_ms and self._now() - self._fire_started_ms >= 4 * self.cfg.fire_ms:
@@ -367,12 +371,14 @@ class Controller(ControllerCore):
             return off if off is not None else self._emit(dp.hold_altitude())
         self._misses = 0
         self._remember_side(det)
-        loose = 2.0 * self.cfg.aim_tolerance
-        far = det.relative_size < self.cfg.retreat_size  # drifted back out of range (AIM approaches again)
+        far = self._too_far(det)  # drifted back out of range (AIM approaches again)
+        near = det.relative_size > self.cfg.back_off_size  # coasting into it (AIM backs off)
         blocked = det.aim_on_target is False  # something in front of the target, where the ray goes
-        if far or blocked or abs(det.error_x) > loose or abs(det.error_y) > loose:
+        # off centre: the spot about to leave the target (the gate's room: the tolerance, or half its radius)
+        if far or near or blocked or not centred(det, self.cfg.fire_tolerance):
             off = self._laser(False)
-            why = "out of range" if far else ("something in front of the target" if blocked else "off centre")
+            why = ("out of range" if far else "too close" if near else
+                   "something in front of the target" if blocked else "off centre")
             self._go(State.AIM, f"{why} while firing")
             return off if off is not None else self._on_aim(det)
         if not self.gate.confirmed():  # vision gate: found, but not confirmed in enough frames in a row
@@ -382,9 +388,10 @@ class Controller(ControllerCore):
         on = self._laser(True)
         if on is not None:
             return on
-        # still within the loose tolerance: keep centring it (a drifting drone), the laser stays on
-        correction = self._servo_correction(det)
-        if correction is not None:
-            return correction
+        # still on the target: hold the range first (a closing speed carries the drone into it), else keep centring
+        # it (a drifting drone); the laser stays on
         hold = self._hold_range(det)
-        return hold if hold is not None else self._emit(dp.hold_altitude())
+        if hold is not None:
+            return hold
+        correction = self._servo_correction(det)
+        return correction if correction is not None else self._emit(dp.hold_altitude())

@@ -37,6 +37,9 @@ class State(enum.Enum):
 FLYING = frozenset({State.TAKEOFF, State.HOLD, State.SEARCH, State.ACQUIRE, State.TRACK, State.AIM, State.FIRE})
 LOCKED = frozenset({State.ACQUIRE, State.TRACK, State.AIM, State.FIRE})
 RESET_ERROR = 0.4  # a servo reset in TRACK may leave the target this far off the middle (of the half-width)
+# a servo step shows in the frames only this long after it is sent: a frame is 30-120 ms old when the pilot reads it
+# (one camera period more after a dropped frame), the servo slews 0.1-0.2 s per 60°, and the step goes out at a tick
+SERVO_SEEN_MS = 200
 
 
 @dataclass(frozen=True)
@@ -91,6 +94,7 @@ class ControllerCore:
         self.last_command: bytes | None = None
         self.polling = False  # this tick's frame is a status poll (the runner sends it more than once)
         self._entered_ms = self._now()
+        self._land_clock_ms = self._now()  # LAND's time limit counts from here (the firmware's routine's start)
         self._hits = 0
         self._misses = 0
         self._centred = 0
@@ -101,6 +105,7 @@ class ControllerCore:
         self._search_started_ms = self._now()
         self._pan_offset = 0  # degrees the pilot has moved the pan servo from its default
         self._tilt_offset = 0
+        self._servo_steps: dict[str, tuple[int, float]] = {}  # "pan"/"tilt": the last step's time and degrees
         tan_h = math.tan(math.radians(self.cfg.horizontal_fov_deg) / 2.0)
         self._tan_h = tan_h
 
@@ -118,7 +123,7 @@ class ControllerCore:
         if new is State.SEARCH and self.state is not State.ACQUIRE:
             self._search_started_ms = self._now()  # a sighting that is not confirmed does not restart the sweep
         self.state = new
-        self._entered_ms = self._now()
+        self._entered_ms = self._land_clock_ms = self._now()
         self._sent_entry = False
         self._hits = 0 if new is State.SEARCH else self._hits
         self._misses = 0
@@ -214,7 +219,7 @@ class ControllerCore:
         """One frame's decision. ``det`` is None when there is no frame this tick."""
         self._account()
         self.polling = False
-        if self.state is State.LAND and (self._elapsed() >= self.cfg.land_ms or self.gave_up):
+        if self.state is State.LAND and (self._now() - self._land_clock_ms >= self.cfg.land_ms or self.gave_up):
             # stop sending: the firmware's failsafe (laser off, failsafe throttle) takes over
             self._go(State.DONE, f"drone did not confirm it disarmed ({self.drone.describe()})")
             return None
@@ -241,25 +246,37 @@ class ControllerCore:
         self._search_sign = 1 if self._bearing(det) >= 0 else -1
 
     def _servo_correction(self, det: Detection) -> bytes | None:
-        """One pan or tilt step towards the target, the larger error first; None when centred."""
+        """One pan or tilt step towards the target, the larger error first; None when centred. A step not yet
+        seen (``SERVO_SEEN_MS``) is taken out of its axis' error first: the frame may predate it, and the same step
+        again would overshoot (a hold while it shows, ``_owed``)."""
         ex, ey = det.error_x, det.error_y
         tol = self.cfg.aim_tolerance
         tan_v = self._tan_v(det)
         if abs(ex) <= tol and abs(ey) <= tol:
             return None
-        if abs(ex) >= abs(ey):
-            deg = max(1, round(math.degrees(math.atan(abs(ex) * self._tan_h))))
-            if ex > 0:
-                self._pan_offset += deg
-                return self._emit(dp.servo_right(deg))
-            self._pan_offset -= deg
-            return self._emit(dp.servo_left(deg))
-        deg = max(1, round(math.degrees(math.atan(abs(ey) * tan_v))))
-        if ey < 0:
-            self._tilt_offset += deg
-            return self._emit(dp.servo_up(deg))
-        self._tilt_offset -= deg
-        return self._emit(dp.servo_down(deg))
+        # degrees each axis must still turn (pan right, tilt up), and the tolerance in degrees
+        pan = self._owed("pan", math.degrees(math.atan(ex * self._tan_h)), math.degrees(math.atan(tol * self._tan_h)))
+        tilt = self._owed("tilt", math.degrees(math.atan(-ey * tan_v)), math.degrees(math.atan(tol * tan_v)))
+        if not pan and not tilt:
+            return self._emit(dp.hold_altitude())  # the last step has not shown yet
+        axis = "pan" if pan and (not tilt or abs(ex) >= abs(ey)) else "tilt"
+        turn = pan if axis == "pan" else tilt
+        deg = max(1, round(abs(turn)))
+        self._servo_steps[axis] = (self._now(), math.copysign(deg, turn))
+        if axis == "pan":
+            self._pan_offset += deg if turn > 0 else -deg
+            return self._emit(dp.servo_right(deg) if turn > 0 else dp.servo_left(deg))
+        self._tilt_offset += deg if turn > 0 else -deg
+        return self._emit(dp.servo_up(deg) if turn > 0 else dp.servo_down(deg))
+
+    def _owed(self, axis: str, seen_deg: float, tol_deg: float) -> float:
+        """The step still due on ``axis`` (0: none): the error seen, less a step that may not show yet; while one
+        may not, only more of the same way past the tolerance (never back: the frame may show it already)."""
+        last = self._servo_steps.get(axis)
+        if last is None or self._now() - last[0] >= SERVO_SEEN_MS:
+            return seen_deg if abs(seen_deg) > tol_deg else 0.0
+        rest = seen_deg - last[1]
+        return rest if rest * last[1] > 0.0 and abs(rest) > tol_deg else 0.0
 
     def _turn_to_camera(self, det: Detection) -> bytes | None:
         """With the camera panned, the turn that brings the body round to the target until a servo reset would

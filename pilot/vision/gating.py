@@ -6,13 +6,13 @@ The controller shows the gate every frame's detection (``observe``) and then ask
   with a confidence at or above ``controller.acquire_confidence``. Turning towards it, approaching and
   aiming need this; anything less counts as a miss.
 * ``confirmed()``: may the laser be on now: the last ``controller.confirm_frames`` frames in a row were
-  each measured (not bridged), acquired, centred within ``controller.fire_tolerance``, estimated closer
-  than ``controller.fire_range_max_m``, and the same steady thing as the frame before (``steady``: a hovering
-  drone's ball changes little from frame to frame; a film's patches come and go, the track hopping between them).
+  each measured (not bridged), acquired, centred (``centre_room``: within ``controller.fire_tolerance``, or
+  within half the target's apparent radius when that is more), estimated closer than
+  ``controller.fire_range_max_m``, and the same steady thing as the frame before (``steady``: a ball changes
+  little from frame to frame; a film's patches come and go). Figures: bench/vision/HISTORY.md.
 
 A bad frame (``FrameStatus`` other than OK) is never a sighting and breaks the confirmation; ``fault`` and
-``fault_frames`` tell the controller to hold and, after ``controller.blind_frames`` of them, to land. Figures:
-bench/vision/HISTORY.md ("Thirty-fifth session").
+``fault_frames`` tell the controller to hold and, after ``controller.blind_frames`` of them, to land.
 """
 
 from __future__ import annotations
@@ -31,6 +31,19 @@ def steady(before: Detection, now: Detection) -> bool:
     big, small = max(before.size, now.size), min(before.size, now.size)
     return small > 0.0 and big <= STEADY_SIZE * small and math.hypot(
         now.cx - before.cx, now.cy - before.cy) <= STEADY_STEP * big
+
+
+SPOT_SHARE = 0.5  # the aim may stray this share of the target's apparent radius: the spot stays on it a late frame on
+
+
+def centre_room(det: Detection, tolerance: float) -> tuple[float, float]:
+    """How far from the target's centre the aim point (the frame's middle, where the laser points) may be, as
+    normalised errors (x, y), for the spot to stay on the target: ``tolerance``, or ``SPOT_SHARE`` of the target's
+    apparent radius where that is more (a near target's spot has room a fixed tolerance would throw away)."""
+    radius = det.size / 2.0
+    room_x = SPOT_SHARE * radius / (det.width / 2.0) if det.width else 0.0
+    room_y = SPOT_SHARE * radius / (det.height / 2.0) if det.height else 0.0
+    return max(tolerance, room_x), max(tolerance, room_y)
 
 
 class Gate:
@@ -58,8 +71,7 @@ class Gate:
             self._acquired
             and det is not None
             and not det.predicted
-            and abs(det.error_x) <= cfg.fire_tolerance
-            and abs(det.error_y) <= cfg.fire_tolerance
+            and centred(det, cfg.fire_tolerance)
             and 0.0 < det.range_m <= cfg.fire_range_max_m
         )
         if not good or det is None:
@@ -74,3 +86,9 @@ class Gate:
 
     def confirmed(self) -> bool:
         return self.streak >= self.cfg.confirm_frames
+
+
+def centred(det: Detection, tolerance: float) -> bool:
+    """Whether the aim point is within ``centre_room`` of the target's centre."""
+    room_x, room_y = centre_room(det, tolerance)
+    return abs(det.error_x) <= room_x and abs(det.error_y) <= room_y

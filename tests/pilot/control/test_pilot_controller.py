@@ -209,7 +209,27 @@ def test_aim_steps_the_servos_only_on_measured_sightings() -> None:
     bridged = dataclasses.replace(low, predicted=True, confidence=0.8)
     assert [name(rig.tick(bridged)) for _ in range(2)] == ["hold_altitude"] * 2
     assert st(c) is State.AIM
-    assert name(rig.tick(low)) == "servo_down"  # measured again: the step is repeated only if still needed
+    assert name(rig.tick(low)) == "hold_altitude"  # measured, but 150 ms after the step: it may not show yet
+    assert name(rig.tick(low)) == "servo_down"  # 200 ms: still needed, so repeated
+
+
+def test_a_servo_step_is_not_repeated_before_a_late_frame_can_show_it() -> None:
+    """Frames reach the pilot up to 120 ms after their exposure and the servo slews: the frames just after a step
+    still show the old error. Stepping on them repeats the step (three of them where one was due, and the spot
+    overshoots the target); a frame that shows more error the same way gets only the difference."""
+    _c, rig = to_state(State.AIM)
+    low = seen(0.0, 0.3, size=0.25)
+    first = rig.tick(low)
+    assert first is not None and dp.decode(first).name == "servo_down"
+    step = dp.decode(first).value
+    assert [name(rig.tick(low)) for _ in range(3)] == ["hold_altitude"] * 3
+    lower = seen(0.0, 0.6, size=0.25)
+    more = rig.tick(lower)  # 200 ms on: the whole of the new error, the first step now shows in any frame
+    assert more is not None and dp.decode(more).name == "servo_down" and dp.decode(more).value > step
+    again = rig.tick(seen(0.0, 0.9, size=0.25))  # further still the same way: only the rest beyond the last step
+    assert again is not None and dp.decode(again).name == "servo_down"
+    assert dp.decode(again).value < dp.decode(more).value
+    assert name(rig.tick(seen(0.0, -0.3, size=0.25))) == "hold_altitude"  # never back while a step may not show
 
 
 def test_aim_backs_off_a_target_it_coasted_up_to_before_it_fires() -> None:

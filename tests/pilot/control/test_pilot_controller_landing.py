@@ -10,6 +10,7 @@ import pytest
 from controller_rig import CFG, MISS, Clock, land_to_done, name, refusal, seen, st, to_state
 
 from pilot.control.controller import Controller, State
+from pilot.control.descent import LAND_FROM_M
 
 N = dp.CommandName
 
@@ -33,8 +34,11 @@ def test_fire_lights_by_confirmation_then_lands_through_the_firmware_routine() -
     assert name(out) == "laser_off" and st(c) is State.LAND and c.fired
     assert abs(c.lit_ms - CFG.fire_ms) <= 50
     frames = land_to_done(rig)
-    assert frames[:2] == ["servo_reset", "land"]  # the firmware's landing routine, then only status polls
-    assert "disarm" not in frames and set(frames[2:]) <= {"land", "query_status"}
+    assert frames[0] == "servo_reset"
+    routine = frames.index("land")  # the pilot's own descent first (see the next test)
+    assert set(frames[1:routine]) == {"move_down"}
+    # the firmware's landing routine, then only status polls
+    assert "disarm" not in frames and set(frames[routine:]) <= {"land", "query_status"}
     assert rig.drone.state is dp.DroneState.DISARMED and not rig.drone.laser
     assert c.drone.safe and "confirmed disarmed" in c.transitions[-1].reason
     assert "laser_toggle" not in [name(f) for f in rig.sent]
@@ -145,6 +149,39 @@ def test_busy_reply_during_arming_is_ignored() -> None:
     c, _rig = to_state(State.ARM)
     c.on_reply(refusal(dp.ErrorKind.BUSY, dp.DroneState.ARMING))
     assert st(c) is State.ARM
+
+
+def test_the_pilot_descends_itself_to_near_the_floor_before_the_landing_routine() -> None:
+    """The landing routine descends slowly with roll and pitch centred, and a trim drift of 0.5 m/s carried the
+    drone into walls on the way down: after its fire the pilot descends itself at twice that speed to
+    ``LAND_FROM_M`` by its height estimate, then hands over to the routine, whose time limit starts then."""
+    c, rig = to_state(State.FIRE)
+    start_m = c.height.m
+    assert start_m > 1.0  # the take-off's climb
+    while st(c) is State.FIRE:
+        rig.tick(seen(size=0.3))
+    assert st(c) is State.LAND and c.fired
+    frames: list[str] = []
+    while not frames or frames[-1] != "land":
+        out = rig.tick(MISS)
+        if out is not None:
+            frames.append(name(out))
+        assert len(frames) < 200
+    assert frames[-2] == "move_down" and frames.count("move_down") >= 10
+    assert c.height.settles_m <= LAND_FROM_M + 0.05
+    land_to_done(rig)
+    assert c.drone.safe and "confirmed disarmed" in c.transitions[-1].reason
+
+
+def test_a_stop_during_the_pilots_descent_hands_over_to_the_landing_routine_at_once() -> None:
+    """Asked to stop (again) while descending: no more of the pilot's own descent, the firmware's routine now."""
+    c, rig = to_state(State.FIRE)
+    while st(c) is State.FIRE:
+        rig.tick(seen(size=0.3))
+    assert name(rig.tick(MISS)) in ("move_down", "hold_altitude", "servo_reset")
+    c.emergency()
+    frames = land_to_done(rig)
+    assert "move_down" not in frames and frames[0] in ("servo_reset", "land")
 
 
 def test_abort_while_firing_lands_and_waits_for_the_drone() -> None:

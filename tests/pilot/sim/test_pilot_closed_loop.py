@@ -8,9 +8,9 @@ fire time, the fire completed, landed and disarmed, nothing else lit, no wall to
 rate itself).
 
 These fly the ideal world (``ideal=True``): in the randomised world, on by default since the thirty-third session,
-the pilot learns the airframe's trim drift from the target (pilot/control/trim.py) but 6 of these 10 HSV flights
-still fail by the strict score (wall touches before the drift is learnt, stays broken by the drift while firing);
-bench/flight/HISTORY.md has the figures."""
+every one of these 10 HSV flights keeps the spot on the target for the fire time since the thirty-fifth session,
+but 3 of them touch a wall or furniture (ahead, low, cluttered: before the drift is learnt, or landing onto
+furniture), short of the 11 of 12 without a touch required here; bench/flight/HISTORY.md has the figures."""
 
 from __future__ import annotations
 
