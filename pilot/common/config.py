@@ -95,9 +95,7 @@ class ControllerConfig:
     acquire_confidence: float = 0.6  # a sighting counts only at or above this confidence
     confirm_frames: int = 3  # measured, confident, centred, in-range frames in a row before the laser may fire
     fire_tolerance: float = 0.10  # normalised error within which a frame counts as centred for the gate
-    # the laser fires only on a target estimated closer than this: the mission's reach, by which the simulator
-    # also judges a stay on the target (the controller aims and holds within 0.8 of it)
-    fire_range_max_m: float = 2.0
+    fire_range_max_m: float = 2.0  # fire only closer than this (aim within 0.8 of it); the simulator judges by it
     blind_frames: int = 20  # bad frames in a row (black, saturated, frozen, malformed) before landing
     # the flight controller holds altitude, not position: the pilot brakes from the closing speed it measures
     brake_mps2: float = 0.5  # deceleration the approach plans with (a 5° lean gives about 0.9 m/s²)

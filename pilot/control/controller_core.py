@@ -105,7 +105,7 @@ class ControllerCore:
         self._search_started_ms = self._now()
         self._pan_offset = 0  # degrees the pilot has moved the pan servo from its default
         self._tilt_offset = 0
-        self._servo_steps: dict[str, tuple[int, float]] = {}  # "pan"/"tilt": the last step's time and degrees
+        self._servo_steps: dict[bool, tuple[int, float]] = {}  # by axis (True: across): the last step's time, degrees
         tan_h = math.tan(math.radians(self.cfg.horizontal_fov_deg) / 2.0)
         self._tan_h = tan_h
 
@@ -255,21 +255,21 @@ class ControllerCore:
         if abs(ex) <= tol and abs(ey) <= tol:
             return None
         # degrees each axis must still turn (pan right, tilt up), and the tolerance in degrees
-        pan = self._owed("pan", math.degrees(math.atan(ex * self._tan_h)), math.degrees(math.atan(tol * self._tan_h)))
-        tilt = self._owed("tilt", math.degrees(math.atan(-ey * tan_v)), math.degrees(math.atan(tol * tan_v)))
+        pan = self._owed(True, math.degrees(math.atan(ex * self._tan_h)), math.degrees(math.atan(tol * self._tan_h)))
+        tilt = self._owed(False, math.degrees(math.atan(-ey * tan_v)), math.degrees(math.atan(tol * tan_v)))
         if not pan and not tilt:
             return self._emit(dp.hold_altitude())  # the last step has not shown yet
-        axis = "pan" if pan and (not tilt or abs(ex) >= abs(ey)) else "tilt"
-        turn = pan if axis == "pan" else tilt
+        across = bool(pan) and (not tilt or abs(ex) >= abs(ey))  # the pan servo's axis, else the tilt's
+        turn = pan if across else tilt
         deg = max(1, round(abs(turn)))
-        self._servo_steps[axis] = (self._now(), math.copysign(deg, turn))
-        if axis == "pan":
+        self._servo_steps[across] = (self._now(), math.copysign(deg, turn))
+        if across:
             self._pan_offset += deg if turn > 0 else -deg
             return self._emit(dp.servo_right(deg) if turn > 0 else dp.servo_left(deg))
         self._tilt_offset += deg if turn > 0 else -deg
         return self._emit(dp.servo_up(deg) if turn > 0 else dp.servo_down(deg))
 
-    def _owed(self, axis: str, seen_deg: float, tol_deg: float) -> float:
+    def _owed(self, axis: bool, seen_deg: float, tol_deg: float) -> float:
         """The step still due on ``axis`` (0: none): the error seen, less a step that may not show yet; while one
         may not, only more of the same way past the tolerance (never back: the frame may show it already)."""
         last = self._servo_steps.get(axis)

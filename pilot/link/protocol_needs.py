@@ -30,7 +30,7 @@ def _read_every_name() -> None:
         dp.turn_left, dp.turn_right, dp.COMMANDS.values, dp.CommandSpec, dp.FAILSAFE_THROTTLE_US,
         dp.ReplyKind.ACCEPTED, dp.SERVOS.values, dp.encode,
         dp.CommandName.MOVE_LEFT, dp.CommandName.MOVE_RIGHT, dp.CommandName.SERVO_LEFT, dp.CommandName.SERVO_RIGHT,
-        dp.CommandName.SERVO_RESET, dp.command_frame,
+        dp.CommandName.SERVO_RESET, dp.command_frame, dp.DroneState.HOLD_ALTITUDE, dp.DroneState.MOVING,
     )
 
 
