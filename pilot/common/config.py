@@ -6,9 +6,8 @@ Every error names the offending option by its dotted path (``controller.fire_ms`
 from __future__ import annotations
 
 import dataclasses
-import os
+import math
 import reprlib
-import stat
 import typing
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,6 +16,7 @@ from typing import Any, TypeVar
 import drone_protocol as dp
 import yaml
 
+from .config_file import read_mapping
 from .errors import ConfigError
 from .ranges import within
 
@@ -284,7 +284,26 @@ def validate(config: PilotConfig, where: str = "config") -> PilotConfig:
             f"{where}: option 'controller.back_off_size' ({c.back_off_size}) must be above "
             f"'controller.approach_size' ({c.approach_size}): AIM would back off from where it stops"
         )
+    _fire_range_reached(config, where)
     return config
+
+
+# AIM fires, and FIRE holds, only within this share of ``controller.fire_range_max_m``: a ball 10 % bigger than
+# configured reads 10 % nearer, and the drone drifts while it fires
+FIRE_RANGE_SHARE = 0.8
+
+
+def _fire_range_reached(config: PilotConfig, where: str) -> None:
+    """The approach must stop where AIM may fire: else TRACK and AIM hand the drone back and forth for ever."""
+    c = config.controller
+    size_m = config.aruco.marker_size_m if config.detector == "aruco" else config.hsv.target_diameter_m
+    stop_m = size_m / (2.0 * c.approach_size * math.tan(math.radians(c.horizontal_fov_deg) / 2.0))
+    if stop_m >= FIRE_RANGE_SHARE * c.fire_range_max_m:
+        raise ConfigError(
+            f"{where}: option 'controller.fire_range_max_m' ({c.fire_range_max_m:g}) is too short: the approach "
+            f"stops about {stop_m:.2f} m from the target ('controller.approach_size' {c.approach_size:g}) and AIM "
+            f"fires only within {FIRE_RANGE_SHARE:g} of the range: set it above {stop_m / FIRE_RANGE_SHARE:.2f} m, "
+            "or raise approach_size")
 
 
 def _in(where: str, option: str, value: float, lo: float, hi: float) -> None:
@@ -327,60 +346,9 @@ def from_dict(data: dict[str, Any], where: str = "config") -> PilotConfig:
     return validate(_build(PilotConfig, data, "", where), where)
 
 
-MAX_CONFIG_BYTES = 1_000_000  # a config is a few kilobytes; this bounds what a wrong file can cost
-
-
-def _read_text(path: Path, where: str) -> str:
-    try:  # without blocking: a FIFO would otherwise wait for a writer for ever
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
-        with open(fd, "rb") as f:
-            if not stat.S_ISREG(mode := os.fstat(fd).st_mode):
-                kind = "a folder" if stat.S_ISDIR(mode) else "not a regular file (a FIFO, a device or a socket)"
-                raise ConfigError(f"{where}: cannot read config: it is {kind}")
-            raw = f.read(MAX_CONFIG_BYTES + 1)
-    except OSError as exc:
-        raise ConfigError(f"{where}: cannot read config: {exc.strerror or exc}") from exc
-    if len(raw) > MAX_CONFIG_BYTES:
-        raise ConfigError(f"{where}: config larger than {MAX_CONFIG_BYTES:,} bytes: is it the right file?")
-    if raw.startswith((b"\xff\xfe", b"\xfe\xff")) or raw[:2].count(0) == 1:
-        raise ConfigError(f"{where}: the config is saved as UTF-16: save it as UTF-8")
-    try:
-        return raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise ConfigError(
-            f"{where}:{line}: the config is not UTF-8 (byte 0x{raw[exc.start]:02x}, perhaps Latin-1 or "
-            "Windows-1252): save it as UTF-8"
-        ) from exc
-
-
-def _yaml_problem(exc: yaml.YAMLError) -> str:
-    """A YAML error on one line: line:column: problem."""
-    if isinstance(exc, yaml.MarkedYAMLError):
-        mark = exc.problem_mark or exc.context_mark
-        problem = " ".join(str(x) for x in (exc.context, exc.problem) if x)
-        where = f"{mark.line + 1}:{mark.column + 1}: " if mark is not None else ""
-        return f"{where}not valid YAML: {' '.join(problem.split())}"
-    return f"not valid YAML: {' '.join(str(exc).split())}"
-
-
 def load(path: str | Path) -> PilotConfig:
     where = str(path) if str(path).isprintable() else repr(str(path))  # a newline in a name keeps to one line
-    text = _read_text(Path(path), where)
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise ConfigError(f"{where}:{_yaml_problem(exc)}" if isinstance(exc, yaml.MarkedYAMLError)
-                          else f"{where}: {_yaml_problem(exc)}") from exc
-    except RecursionError as exc:
-        raise ConfigError(f"{where}: not valid YAML: nested too deep for a config") from exc
-    except ValueError as exc:  # an integer of thousands of digits, a bad timestamp
-        raise ConfigError(f"{where}: not valid YAML: {' '.join(str(exc).split())[:160]}") from exc
-    if data is None:
-        data = {}
-    if not isinstance(data, dict):
-        raise ConfigError(f"{where}: the top level must be a mapping of options")
-    return from_dict(data, where)
+    return from_dict(read_mapping(Path(path), where), where)
 
 
 def _plain(value: Any) -> Any:

@@ -18,7 +18,7 @@ from collections.abc import Callable, Mapping
 
 import drone_protocol as dp
 
-from ..common.config import ControllerConfig
+from ..common.config import FIRE_RANGE_SHARE, ControllerConfig
 from ..vision.detection import Detection
 from ..vision.gating import Gate, centred
 from .approach import ClosingSpeed, Lead, Lean, Momentum, allowed_speed, brake_steps
@@ -37,9 +37,6 @@ VIEW_EDGE = 0.9  # a brake's lean keeps the target's lower edge above this share
 MIN_BRAKE = 0.4  # control steps: the gentlest brake, whatever the view allows
 TRIMMED = FLYING - {State.TAKEOFF}  # the states that lean against the drift (the take-off's climb takes every frame)
 HELD = frozenset({State.ACQUIRE, State.AIM, State.FIRE})  # no approach commanded: the closing speed is drift
-# AIM fires, and FIRE holds, only within this share of the fire range: a ball 10 % bigger than configured reads
-# 10 % nearer, and the drone drifts while it fires
-FIRE_RANGE_SHARE = 0.8
 PITCH_CALM_MS = 1500  # ... once the pilot's own pitch has been neutral this long (a brake's lean and speed gone)
 
 

@@ -1,5 +1,6 @@
 """Options checked at start-up whichever detector flies: a wrong ``aruco.dictionary`` is refused like every other
-bad option (one line naming the option and the file, exit 2), not left to fail when the detector is switched."""
+bad option (one line naming the option and the file, exit 2), not left to fail when the detector is switched; a
+fire range shorter than where the approach stops is refused, naming the figure to use."""
 
 from __future__ import annotations
 
@@ -30,3 +31,19 @@ def test_the_command_line_refuses_it_at_start_up_with_the_hsv_detector(tmp_path:
     code, out, err = call("--config", str(config), "--dry-run", "--no-status", "--max-seconds", "0.2")
     assert code == 2 and out == "", (code, out, err)
     assert err.count("\n") == 1 and "aruco.dictionary" in err and str(config) in err and "Traceback" not in err, err
+
+
+@pytest.mark.parametrize("detector", ["hsv", "aruco"])
+def test_a_fire_range_the_approach_never_reaches_is_refused_with_the_figure(detector: str) -> None:
+    # the 0.3 m target at 0.19 of a 60° frame is about 1.37 m away: AIM fires within 0.8 of the range, so 1.71 m
+    with pytest.raises(ConfigError, match=r"^pilot\.yaml: option 'controller\.fire_range_max_m' \(1\.5\) is too "
+                                          r"short: the approach stops about 1\.37 m .* set it above 1\.71 m"):
+        from_dict({"detector": detector, "controller": {"fire_range_max_m": 1.5}}, "pilot.yaml")
+    assert from_dict({"detector": detector, "controller": {"fire_range_max_m": 1.75}}).controller.fire_range_max_m == 1.75
+
+
+def test_a_short_fire_range_is_accepted_where_the_approach_stops_nearer() -> None:
+    options = {"controller": {"fire_range_max_m": 1.5, "approach_size": 0.25}, "hsv": {"target_diameter_m": 0.3}}
+    assert from_dict(options).controller.fire_range_max_m == 1.5
+    with pytest.raises(ConfigError, match="fire_range_max_m"):  # a bigger ball stops the approach further away
+        from_dict({**options, "hsv": {"target_diameter_m": 0.4}})
