@@ -2,9 +2,8 @@
 
 The controller shows the gate every frame's detection (``observe``) and then asks it two questions:
 
-* ``acquired()``: is there a target worth acting on now: found (measured, or bridged by the tracker)
-  with a confidence at or above ``controller.acquire_confidence``. Turning towards it, approaching and
-  aiming need this; anything less counts as a miss.
+* ``acquired()``: is there a target worth acting on now: found (measured, or bridged by the tracker) with a
+  confidence at or above ``controller.acquire_confidence``. Turning, approaching and aiming need this; less is a miss.
 * ``confirmed()``: may the laser be on now: the last ``controller.confirm_frames`` frames in a row were
   each measured (not bridged), acquired, centred (``centre_room``: within ``controller.fire_tolerance``, or
   within half the target's apparent radius when that is more), estimated closer than
