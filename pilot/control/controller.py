@@ -84,8 +84,8 @@ class Controller(ControllerCore):
         return None if closing is None else closing + self.lead.speed
 
     def _brake(self, speed: float, det: Detection | None = None) -> bytes:
-        """Pitch back against a closing speed (``_brake_steps``), with the target in view no harder than keeps it in
-        the frame (the nose comes up with the brake, see ``_brake_room``)."""
+        """Pitch back against a closing speed (``approach.brake_steps``), with the target in view no harder than
+        keeps it in the frame (the nose comes up with the brake, see ``_brake_room``)."""
         frac = brake_steps(speed)
         if det is not None and det.found:
             frac = max(MIN_BRAKE, min(frac, self._brake_room(det)))

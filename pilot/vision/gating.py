@@ -76,8 +76,8 @@ class Gate:
         if not good or det is None:
             self.streak = 0
             return
-        same = not self.steadiness or (self.streak > 0 and self._last is not None and steady(self._last, det))
-        self.streak = self.streak + 1 if same or self.streak == 0 else 1
+        other = self.steadiness and self.streak > 0 and self._last is not None and not steady(self._last, det)
+        self.streak = 1 if other else self.streak + 1  # another thing: the streak starts again at it
         self._last = det
 
     def acquired(self) -> bool:
