@@ -15,6 +15,7 @@ that the next run completes (roll forward): all old or all new only once that ru
 from __future__ import annotations
 
 import errno
+import fnmatch
 import json
 import os
 import shutil
@@ -134,7 +135,7 @@ def _link_tree(src: Path, dest: Path) -> None:
     shutil.copystat(src, dest)
     for entry in os.scandir(src):
         target = dest / entry.name
-        if entry.name == STAGING or (entry.name.startswith(".") and entry.name.endswith(".tmp")):
+        if entry.name == STAGING or fnmatch.fnmatch(entry.name, STRAY):  # the debris the next run removes
             continue
         if entry.is_symlink():
             os.symlink(os.readlink(entry.path), target)
