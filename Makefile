@@ -41,8 +41,9 @@ $(VENV_STAMP): pyproject.toml setup.py generated/python/pyproject.toml
 	@test -x $(PY) || $(PYTHON_SYSTEM) -m venv $(VENV)
 	@echo "Installing the Python environment in $(VENV) (the codec, the project and its dev tools)"
 	@mkdir -p build
-	@# pip's and setuptools' chatter goes to a log, shown only when the install fails
-	@{ $(PY) -m pip install -q --upgrade pip && $(PY) -m pip install -q -e generated/python -e '.[dev]'; } \
+	@# pip's and setuptools' chatter goes to a log, shown only when the install fails; --no-compile: byte-compiling
+	@# every module of scipy, scikit-learn and the rest was most of the install's time (Python compiles what it imports)
+	@{ $(PY) -m pip install -q --upgrade pip && $(PY) -m pip install -q --no-compile -e generated/python -e '.[dev]'; } \
 	  >build/pip-install.log 2>&1 || { cat build/pip-install.log; echo "pip install failed (log: build/pip-install.log)"; exit 1; }
 	@touch $@
 
