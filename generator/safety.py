@@ -9,16 +9,16 @@ check (CRC-8 detects every single-byte error), so none can pass as the other."""
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
 
 from .model import Command, Direction, Spec, check_text
+from .records import record
 
 # What a command does to safety; a command without `safety:` is routine (moves, turns, servos, holding).
 SAFETY_EFFECTS = ("arm", "disarm", "land", "laser_on", "laser_off", "laser_toggle", "self_test")
 ROUTINE = "routine"
 
 
-@dataclass(frozen=True)
+@record
 class Neighbours:
     """Commands `a` and `b` (in spec order) and how many valid frames of `a` are one byte from one of `b`."""
 
@@ -124,7 +124,7 @@ def _safe_defaults(spec: Spec) -> tuple[tuple[Command, str], ...]:
     return tuple(out)
 
 
-@dataclass(frozen=True)
+@record
 class _Group:
     """The valid wire frames of the commands of one safety effect, stored by column (byte j of every frame) so
     that distances are counted in C, and where each command's frames lie within the group."""
