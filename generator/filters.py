@@ -143,6 +143,9 @@ def one_in(p: float) -> str:
     return "never" if p == 0 else f"1 in {float(f'{1 / p:.3g}'):,.0f}"
 
 
+# json.dumps(v, sort_keys=True), without making an encoder for each of the 2,800 values the templates print
+_TO_JSON = json.JSONEncoder(sort_keys=True)
+
 ALL: dict[str, Callable[..., Any]] = {
     "cpp_char": cpp_char,
     "cpp_string": cpp_string,
@@ -164,6 +167,6 @@ ALL: dict[str, Callable[..., Any]] = {
     "wrap": wrap,
     "block_comment": block_comment,
     "regex_class": regex_class,
-    "tojson": lambda v: json.dumps(v, sort_keys=True),
+    "tojson": _TO_JSON.encode,
     "add_suffix": lambda text, suffix: f"{text}{suffix}",
 }
