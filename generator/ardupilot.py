@@ -8,9 +8,8 @@ ArduCopter 3.2.1 (`ArduCopter/Parameters.pde`, `radio.pde`, `switches.pde`, `lib
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from .model import Spec
+from .records import record
 
 # ArduCopter's flight-mode slots: a pulse up to each bound selects slot 1, 2, ... (FLTMODE1..FLTMODE6). The same
 # in 3.2.1 (readSwitch) and 4.x (read_6pos_switch).
@@ -26,7 +25,7 @@ THR_DZ_RANGE = (0, 300)  # the range ArduPilot documents for THR_DZ
 INT8, INT16 = 2, 4
 
 
-@dataclass(frozen=True)
+@record
 class FirmwareLine:
     """One ArduCopter release line whose parameter names and behaviour the generator knows."""
 
@@ -61,7 +60,7 @@ def supported() -> str:
     return ", ".join(f"{candidate.key} ({candidate.versions})" for candidate in LINES)
 
 
-@dataclass(frozen=True)
+@record
 class Param:
     name: str
     value: int
@@ -69,7 +68,7 @@ class Param:
     mav_type: int = INT8  # MAV_PARAM_TYPE, for QGroundControl's .params
 
 
-@dataclass(frozen=True)
+@record
 class LineParams:
     """The parameter file of one firmware line."""
 

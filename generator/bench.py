@@ -8,15 +8,15 @@ runs the firmware through the same steps and compares every cell."""
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 
 from .model import Spec
+from .records import record
 
 _CONSTANT = re.compile(r"^constexpr\s+\w+\s+([A-Z][A-Z0-9_]*)\s*=\s*(\d+);", re.MULTILINE)
 KEPT = ""  # a cell the step leaves as it was
 
 
-@dataclass(frozen=True)
+@record
 class Step:
     when: str  # the row's first cell; {ARMING_HOLD_MS} and the like are filled from the header
     changes: tuple[tuple[str, str], ...]  # (channel or "mode", constant) where the step differs from neutral
@@ -35,7 +35,7 @@ STEPS = (
 )
 
 
-@dataclass(frozen=True)
+@record
 class Row:
     when: str
     cells: tuple[str, ...]  # one per spec channel, then the mode: a pulse width in us, or "kept"

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import difflib
 import hashlib
 import json
 from pathlib import Path
@@ -14,7 +13,7 @@ from .build_commands import CommandsBuilder
 from .diff import Contract, contract, version_problem
 from .errors import SpecError, SpecInvalid
 from .model import INTEGRITY_MODES, Channel, ErrorKind, Field, Reply, Servo, Settled, Spec
-from .names import identifier_problem, protocol_name_problem, safe_file_name
+from .names import close_matches, identifier_problem, protocol_name_problem, safe_file_name
 from .reader import Reader, is_code, is_int, kind_name, unique_code
 from .source import INVALID, Node, display_path, load, read
 from .status import read_status
@@ -100,7 +99,7 @@ class _Builder(CommandsBuilder):
         # A spec without the key gets crc8, the default of new specs (bench/lossy/RESULTS.md has the figures).
         integrity = frame.text("integrity", DEFAULT_INTEGRITY)
         if integrity not in INTEGRITY_MODES:
-            near = difflib.get_close_matches(integrity, INTEGRITY_MODES, n=1)
+            near = close_matches(integrity, INTEGRITY_MODES)
             frame.error(frame.node.children["integrity"], f"unknown integrity mode '{integrity}'",
                         f"did you mean '{near[0]}'?" if near else "none or crc8", frame.sub("integrity"))
         frame.finish()
@@ -324,7 +323,7 @@ class _Builder(CommandsBuilder):
         for name, node in top.entries("replies"):
             r = Reader(node, f"replies.{name}", self.errors)
             if name not in REPLIES:
-                near = difflib.get_close_matches(name, REPLIES, n=1)
+                near = close_matches(name, REPLIES)
                 self.errors.append(SpecError(node.key_location, r.path, f"unknown reply '{name}'",
                                              f"did you mean '{near[0]}'?" if near else "known: " + ", ".join(REPLIES)))
                 continue

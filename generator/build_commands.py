@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import difflib
 from typing import Optional, TypeVar
 
 from .errors import SpecError
 from .model import Category, Channel, Direction, Field, Servo
-from .names import identifier_problem
+from .names import close_matches, identifier_problem
 from .reader import Reader, is_code
 from .safety import SAFETY_EFFECTS
 from .source import Node
@@ -86,7 +85,7 @@ class CommandsBuilder:
         return categories
 
     def _unknown(self, r: Reader, key: str, value: str, known: dict[str, T]) -> None:
-        near = difflib.get_close_matches(value, sorted(known), n=1)
+        near = close_matches(value, sorted(known))
         hint = f"did you mean '{near[0]}'?" if near else "known: " + ", ".join(sorted(known))
         r.error(r.node.children[key], f"unknown {key} '{value}'", hint, r.sub(key))
 
@@ -115,7 +114,7 @@ class CommandsBuilder:
         routine = r.text("routine", "")
         safety = r.text("safety", "")
         if safety and safety not in SAFETY_EFFECTS:
-            near = difflib.get_close_matches(safety, SAFETY_EFFECTS, n=1)
+            near = close_matches(safety, SAFETY_EFFECTS)
             r.error(r.node.children["safety"], f"unknown safety effect '{safety}'",
                     f"did you mean '{near[0]}'?" if near else "known: " + ", ".join(SAFETY_EFFECTS), r.sub("safety"))
         default_node = r.node.children.get("default")
@@ -156,7 +155,7 @@ class CommandsBuilder:
             value = default_node.value
             if isinstance(value, str) and channel_name is not None:
                 if value not in SPEED_LABELS:
-                    near = difflib.get_close_matches(value, SPEED_LABELS, n=1)
+                    near = close_matches(value, SPEED_LABELS)
                     r.error(default_node, f"unknown speed '{value}'",
                             f"did you mean '{near[0]}'?" if near else "low, median or high", r.sub("default"))
                     return None

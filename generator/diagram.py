@@ -3,16 +3,15 @@ row per Arduino pin, a wire to what it connects to. The template only prints the
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from .model import Spec
+from .records import record
 
 COLOURS = {"rc": "#0550ae", "servo": "#8250df", "laser": "#cf222e", "power": "#1b1f24", "usb": "#116329"}
 ROW_PX = 34
 TOP_PX = 70
 
 
-@dataclass(frozen=True)
+@record
 class Wire:
     y: int
     pin: str  # "D2", "GND", "USB"

@@ -10,11 +10,11 @@ breaking edit whose protocol.version did not rise, without git or the old spec f
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from typing import Any
 
 from .ardupilot import parameter_files
 from .model import Spec
+from .records import record
 
 Contract = dict[str, Any]
 
@@ -84,7 +84,7 @@ def contract_problem(found: object) -> str | None:
     return None
 
 
-@dataclass(frozen=True)
+@record
 class Change:
     breaking: bool
     what: str

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from .records import record
 
 
-@dataclass(frozen=True)
+@record
 class Location:
     file: str
     line: int  # 1-based
@@ -15,7 +15,7 @@ class Location:
         return f"{self.file}:{self.line}:{self.column}"
 
 
-@dataclass(frozen=True)
+@record
 class SpecError:
     location: Location
     path: str  # dotted path inside the spec, e.g. categories.m.directions.f.default

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from .records import record
 
 
-@dataclass(frozen=True)
+@record
 class Channel:
     """One RC channel of Table 4, with the derived speeds."""
 
@@ -21,7 +21,7 @@ class Channel:
         return {"low": self.low, "median": self.median, "high": self.high}[label]
 
 
-@dataclass(frozen=True)
+@record
 class Servo:
     name: str
     description: str
@@ -30,7 +30,7 @@ class Servo:
     default_deg: int
 
 
-@dataclass(frozen=True)
+@record
 class Field:
     name: str
     width: int
@@ -39,7 +39,7 @@ class Field:
     parameter: str  # the argument name of generated functions; "" for a constant field
 
 
-@dataclass(frozen=True)
+@record
 class Direction:
     code: str
     name: str
@@ -64,7 +64,7 @@ class Direction:
         return self.minimum if self.default is None else self.default
 
 
-@dataclass(frozen=True)
+@record
 class Category:
     code: str
     name: str
@@ -74,7 +74,7 @@ class Category:
     filler: bool
 
 
-@dataclass(frozen=True)
+@record
 class ByteLookup:
     """A dense table from a byte to an index + 1 (0: none), covering codes first..first + len(entries) - 1.
 
@@ -85,7 +85,7 @@ class ByteLookup:
     entries: tuple[int, ...]
 
 
-@dataclass(frozen=True)
+@record
 class Command:
     """A (category, direction) pair flattened for the templates."""
 
@@ -94,7 +94,7 @@ class Command:
     direction: Direction
 
 
-@dataclass(frozen=True)
+@record
 class ErrorKind:
     index: int  # 1-based; 0 is "none" in the C++ enum
     name: str
@@ -102,14 +102,14 @@ class ErrorKind:
     description: str
 
 
-@dataclass(frozen=True)
+@record
 class Reply:
     name: str
     prefix: str
     description: str
 
 
-@dataclass(frozen=True)
+@record
 class StatusState:
     """One state of the drone's state machine as its replies report it."""
 
@@ -119,7 +119,7 @@ class StatusState:
     description: str
 
 
-@dataclass(frozen=True)
+@record
 class Status:
     """What every accepted, rejected and failsafe reply carries after `separator`: a state code, a laser code."""
 
@@ -137,7 +137,7 @@ class Status:
         return len(self.separator) + 2
 
 
-@dataclass(frozen=True)
+@record
 class Settled:
     """One inconsistency of the seed document and what the spec decides."""
 
@@ -146,7 +146,7 @@ class Settled:
     decision: str
 
 
-@dataclass(frozen=True)
+@record
 class Vector:
     """One conformance case: a frame and what decoding it must give."""
 
@@ -160,7 +160,7 @@ class Vector:
     position: int  # byte index of the error, -1 when valid
 
 
-@dataclass(frozen=True)
+@record
 class FlightControllerSetup:
     """How the flight controller reads the sticks (spec section `flight_controller`, optional)."""
 
@@ -169,7 +169,7 @@ class FlightControllerSetup:
     firmware: tuple[str, ...]  # the ArduCopter lines to write parameter files for (ardupilot.LINES keys)
 
 
-@dataclass(frozen=True)
+@record
 class Project:
     """Who publishes the generated library and packages (spec section `project`)."""
 
@@ -178,14 +178,14 @@ class Project:
     url: str
 
 
-@dataclass(frozen=True)
+@record
 class WiredPin:
     name: str  # a channel name or "mode" (RC outputs), a servo name, "laser" or "ppm"
     pin: int  # Arduino pin number
     rc_input: int  # 1-based flight-controller input (RC channel), 0 for outputs that are not RC
 
 
-@dataclass(frozen=True)
+@record
 class Wiring:
     """Where the firmware's outputs leave the Arduino (spec section `wiring`)."""
 
@@ -199,7 +199,7 @@ class Wiring:
         return next((p.rc_input for p in self.rc_inputs if p.name == name), 0)
 
 
-@dataclass(frozen=True)
+@record
 class Spec:
     source_name: str
     fingerprint: str  # sha256 of the canonical spec, hex

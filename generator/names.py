@@ -7,6 +7,7 @@ import pkgutil
 import re
 import sys
 import sysconfig
+from collections.abc import Iterable
 from pathlib import Path
 
 IDENTIFIER = re.compile(r"^[a-z][a-z0-9]*(_[a-z0-9]+)*$")
@@ -100,3 +101,10 @@ def safe_file_name(path: Path) -> str:
     """The spec's base name as printed into generated files: only characters inert in every target's comments
     and strings (no newline, quote, `*/`, `-->`); anything else becomes '_'."""
     return _UNSAFE_IN_NAME.sub("_", path.name)[:64] or "spec"
+
+
+def close_matches(word: str, options: Iterable[str]) -> list[str]:
+    """The option nearest to a misspelt `word`, if one is near enough (difflib, imported only for a bad spec)."""
+    import difflib
+
+    return difflib.get_close_matches(word, list(options), n=1)

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import difflib
 import re
 from typing import TypeVar
 
 from .errors import SpecError
+from .names import close_matches
 from .source import INVALID, Node
 
 T = TypeVar("T")
@@ -93,7 +93,7 @@ class Reader:
             return
         for key, node in self.node.children.items():
             if key not in self.seen:
-                near = difflib.get_close_matches(key, sorted(self.seen), n=1)
+                near = close_matches(key, sorted(self.seen))
                 hint = f"did you mean '{near[0]}'?" if near else "known keys: " + ", ".join(sorted(self.seen))
                 self.errors.append(SpecError(node.key_location, self.sub(key), f"unknown key '{key}'", hint))
 

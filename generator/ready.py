@@ -7,10 +7,9 @@ A line that starts with the prefix and breaks the rule is a malformed ready repl
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from .model import INTEGRITY_MODES, Spec, check_text
 from .names import MAX_NAME
+from .records import record
 
 SEPARATOR = " "
 PROTOCOL_CHARACTERS = "0123456789_abcdefghijklmnopqrstuvwxyz"
@@ -24,7 +23,7 @@ GAPS = ("", "  ", "   ", "\t", "\v", "\f", "\r", "\n", "\x00", "\x1c", "\x1d", "
         " \t", "\t ", " \v", "\r ", " \x00")
 
 
-@dataclass(frozen=True)
+@record
 class ReadyVector:
     """One line (as received, its check and line end included) and what parsing it must give."""
 

@@ -9,16 +9,16 @@ check (CRC-8 detects every single-byte error), so none can pass as the other."""
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
 
 from .model import Command, Direction, Spec, check_text
+from .records import record
 
 # What a command does to safety; a command without `safety:` is routine (moves, turns, servos, holding).
 SAFETY_EFFECTS = ("arm", "disarm", "land", "laser_on", "laser_off", "laser_toggle", "self_test")
 ROUTINE = "routine"
 
 
-@dataclass(frozen=True)
+@record
 class Neighbours:
     """Commands `a` and `b` (in spec order) and how many valid frames of `a` are one byte from one of `b`."""
 
@@ -124,7 +124,7 @@ def _safe_defaults(spec: Spec) -> tuple[tuple[Command, str], ...]:
     return tuple(out)
 
 
-@dataclass(frozen=True)
+@record
 class _Group:
     """The valid wire frames of the commands of one safety effect, stored by column (byte j of every frame) so
     that distances are counted in C, and where each command's frames lie within the group."""
@@ -135,33 +135,49 @@ class _Group:
 
 
 @functools.lru_cache(maxsize=4)
-def _targets(spec: Spec, crc8: bool) -> tuple[dict[bytes, tuple[bytes, int, str]], tuple[_Group, ...]]:
-    """Every valid frame of the spec on the wire (with its check in crc8 mode) with its command's index and
-    effect, keyed by the frame with and without its check; and the same frames grouped by effect."""
+def _targets(spec: Spec, crc8: bool) -> tuple[_Group, ...]:
+    """Every valid frame of the spec on the wire (with its check in crc8 mode), grouped by safety effect."""
     table = [int(check_text(bytes([b])), 16) for b in range(256)]
-    frames: dict[bytes, tuple[bytes, int, str]] = {}
     by_effect: dict[str, tuple[list[bytes], dict[int, tuple[int, int]]]] = {}
     for c in spec.commands:
         d = c.direction
-        effect = d.safety or ROUTINE
-        wires, spans = by_effect.setdefault(effect, ([], {}))
+        wires, spans = by_effect.setdefault(d.safety or ROUTINE, ([], {}))
         first = len(wires)
-        for value in range(d.minimum, d.maximum + 1):
-            frame = d.frame(c.category.code, value).encode()
-            crc = 0
-            for byte in frame:
-                crc = table[crc ^ byte]
-            wire = frame + b"%02X" % crc if crc8 else frame
-            frames.setdefault(frame, (wire, c.index, effect))
-            frames.setdefault(wire, (wire, c.index, effect))
-            wires.append(wire)
+        prefix, width = d.frame(c.category.code, 0)[:-d.field.width].encode(), d.field.width
+        if not crc8:
+            wires += [prefix + b"%0*d" % (width, value) for value in range(d.minimum, d.maximum + 1)]  # d.frame()
+        head, state = b"", 0
+        for value in range(d.minimum, d.maximum + 1) if crc8 else ():
+            frame = prefix + b"%0*d" % (width, value)
+            if frame[:-1] != head:  # the check of all but the last digit: once per ten values
+                head, state = frame[:-1], 0
+                for byte in head:
+                    state = table[state ^ byte]
+            wires.append(frame + b"%02X" % table[state ^ frame[-1]])
         spans[c.index] = (first, len(wires))
     lengths = {len(w) for wires, _ in by_effect.values() for w in wires}
     if len(lengths) > 1:
         raise ValueError(f"wire frames of different lengths {sorted(lengths)}: no Hamming distance between them")
-    groups = tuple(_Group(effect, tuple(b"".join(wires)[j::len(wires[0])] for j in range(len(wires[0]))), spans)
-                   for effect, (wires, spans) in by_effect.items())
-    return frames, groups
+    return tuple(_Group(effect, tuple(b"".join(wires)[j::len(wires[0])] for j in range(len(wires[0]))), spans)
+                 for effect, (wires, spans) in by_effect.items())
+
+
+def _sent(spec: Spec, frame: bytes, crc8: bool) -> tuple[bytes, int, str]:
+    """The valid frame `frame` (with or without its check in crc8 mode) as sent, its command's index and effect;
+    KeyError if no command sends it."""
+    for c in spec.commands:
+        d = c.direction
+        width = d.field.width
+        prefix = d.frame(c.category.code, 0)[:-width].encode()
+        digits = frame[len(prefix):len(prefix) + width]
+        if not frame.startswith(prefix) or not digits.lstrip(b"-").isdigit():
+            continue
+        value = int(digits)
+        plain = d.frame(c.category.code, value).encode()
+        wire = plain + check_text(plain).encode() if crc8 else plain
+        if d.minimum <= value <= d.maximum and frame in (plain, wire):
+            return wire, c.index, d.safety or ROUTINE
+    raise KeyError(frame)
 
 
 @functools.cache
@@ -174,8 +190,8 @@ def substitution_rates(spec: Spec, frame: bytes, crc8: bool, q: float) -> tuple[
     """Exact probabilities that `frame`, each of its wire bytes replaced with probability q by one of the 255
     others, arrives as another valid command, and as one with another safety effect: the sum, over every valid
     wire frame of another command at Hamming distance d, of q^d (1-q)^(n-d) / 255^d."""
-    frames, groups = _targets(spec, crc8)
-    sent, index, effect = frames[frame]
+    groups = _targets(spec, crc8)
+    sent, index, effect = _sent(spec, frame, crc8)
     n = len(sent)
     other = hazard = 0.0
     for group in groups:

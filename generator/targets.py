@@ -5,11 +5,12 @@ decided per file (a target mixes formats: the Arduino library has C++ next to a 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import PurePosixPath
 
+from .records import record
 
-@dataclass(frozen=True)
+
+@record
 class Target:
     name: str  # the folder of templates under generator/templates/
     out_dir: str  # where its files go, relative to the output folder ("" for the top)

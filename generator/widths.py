@@ -9,13 +9,13 @@ Python ints are unbounded and need no entry.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from types import MappingProxyType
 
 from .model import Spec
+from .records import record
 
 
-@dataclass(frozen=True)
+@record
 class CType:
     name: str
     minimum: int
@@ -61,7 +61,7 @@ CTYPES: Mapping[str, CType] = MappingProxyType({
 })
 
 
-@dataclass(frozen=True)
+@record
 class Constant:
     """A number the C++ target declares: its name there, type, value and where the spec writes it."""
 

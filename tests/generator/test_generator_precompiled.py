@@ -115,3 +115,29 @@ def test_code_that_cannot_prove_its_source_is_not_used_and_is_written_again(fold
     envs = _envs()
     assert envs["t"].get_template("sub/a.txt.j2").render(who="world") == "hello world"
     assert refresh(envs) == [compiled] and "HELLO" not in compiled.read_text(encoding="utf-8")
+
+
+def test_the_shortened_code_renders_what_jinja_own_code_renders(monkeypatch: pytest.MonkeyPatch) -> None:
+    spec = load_spec(REPO / "spec" / "drone.yaml")
+    shortened = render_all(spec, environments())
+    monkeypatch.setenv(precompiled.NO_PRECOMPILED, "1")
+    monkeypatch.setattr(precompiled, "shorten", lambda code: code)
+    assert render_all(spec, environments()) == shortened
+
+
+@pytest.mark.parametrize(("source", "error", "message"), [
+    ("{% if x %}{{ x | nosuch }}{% endif %}", jinja2.TemplateRuntimeError, "No filter named 'nosuch' found."),
+    ("{% if x %}{{ x is nosuch }}{% endif %}", jinja2.TemplateRuntimeError, "No test named 'nosuch' found."),
+    ("{% if x %}{{ who.name }}{% endif %}", jinja2.UndefinedError, "'who' is undefined"),
+])
+def test_the_shortened_code_fails_as_jinja_own_code_does(folders: tuple[Path, Path], source: str,
+                                                          error: type[Exception], message: str) -> None:
+    template, compiled = folders
+    template.write_text(source, encoding="utf-8")
+    env = jinja2.Environment(loader=PrecompiledLoader("t", "options"), undefined=jinja2.StrictUndefined)
+    assert refresh({"t": env}) == [compiled] and "_defined(" in compiled.read_text(encoding="utf-8")
+    assert env.get_template("sub/a.txt.j2").render(x=0) == ""  # a lookup or a variable never used: no error
+    for used in (env, jinja2.Environment(undefined=jinja2.StrictUndefined)):  # precompiled, then Jinja's own
+        loaded = used.get_template("sub/a.txt.j2") if used is env else used.from_string(source)
+        with pytest.raises(error, match=f"^{message}$"):
+            loaded.render(x=1)
