@@ -9,9 +9,15 @@ from __future__ import annotations
 
 import operator
 from dataclasses import FrozenInstanceError
-from typing import Any, TypeVar, dataclass_transform
+from typing import TYPE_CHECKING, Any, Callable, TypeVar
 
 T = TypeVar("T")
+
+if TYPE_CHECKING:  # typing has it from Python 3.11; the generator runs on 3.9
+    from typing_extensions import dataclass_transform
+else:
+    def dataclass_transform(**_: object) -> Callable[[T], T]:
+        return lambda decorated: decorated
 
 
 @dataclass_transform(frozen_default=True)
