@@ -2,12 +2,14 @@
 
 AltHold levels what the flight controller's accelerometers call level; a level off by a fraction of a degree drifts
 the airframe at up to about 0.5 m/s with centred sticks, and nothing holds position. The pilot sees the drift only
-through the target: with the heading held, the target's lateral offset (range times the sine of its bearing) moves
-at the drift's sideways speed, its range at the forward one. ``Drift`` fits that sideways speed and learns the
-lean that cancels both (an integral of the speeds, kept while the target is out of view). ``TrimSticks`` applies
-it: the firmware drives one stick per frame and centres the others, so a frame that would centre every stick (a
-hold) carries a roll or pitch trim instead, whichever axis is owed the most lean, and a pitch command carries the
-pitch trim. Degrees of lean throughout; ``StickModel`` turns them into pulses from the spec.
+through the target: its lateral offset (range times the sine of its bearing, across the line of sight at a reference
+heading) moves at the drift's sideways speed, its range at the forward one. The heading is held, or turned gently
+and reckoned from the yaw commands (a drifting drone's target slides, and the tracking turns after it all the way:
+learning only with the heading held, the drift was never learnt). ``Drift`` fits that sideways speed and learns the
+lean that cancels both (an integral of the speeds, kept while the target is out of view). ``TrimSticks`` applies it:
+the firmware drives one stick per frame and centres the others, so a frame that would centre every stick (a hold)
+carries a roll or pitch trim instead, whichever axis is owed the most lean, and a pitch command carries the pitch
+trim. Degrees of lean throughout; ``StickModel`` turns them into pulses from the spec.
 """
 
 from __future__ import annotations
@@ -23,17 +25,29 @@ from .pulses import StickModel
 
 LATERAL_WINDOW_S = 1.0  # the sideways speed is the slope of this much of the lateral offset
 LATERAL_MIN_SAMPLES = 6
-SETTLE_MS = 300  # after a turn or a pan step, the frames (up to 120 ms old) show the heading still moving
+SETTLE_MS = 300  # after a hard turn or a pan step, the frames (up to 120 ms old) show the heading still moving
 LEARN_DPS_PER_MPS = 1.0  # the trim's integral: degrees of lean a second per m/s of drift
 DAMP_DEG_PER_MPS = 3.0  # the lean against a measured sideways speed, beyond the trim
 TRIM_MAX_DEG = 2.0  # the trim learnt, at most (a drift of 0.5 m/s takes about 0.6-0.8°)
 DEBT_MAX_DEG_S = 0.5  # lean owed (degrees times seconds) that carries over to the next free frame, at most
 PAY_MIN_DEG_S = 0.005  # owed less than this on both axes: the hold stays a hold
+# the body's heading, reckoned from the yaw commands (pulses.turn_dps, the spec's PILOT_Y_RATE), as the frames show
+# it: a frame is 30-120 ms old (pilot/sim/README.md; libcamera hands one over one to three frame periods late), so
+# the middle of that; a turn of 12°/s then puts at most 0.54° (2 cm at 2 m) into an offset, constant while it lasts
+FRAME_AGE_S = 0.075
+# a turn's start and stop lag the reckoning by rate^2 / (2 ATC_ACCEL_Y_MAX): 0.55° at half a step (17°/s at
+# ArduCopter's default ATC_ACCEL_Y_MAX, 270°/s^2), 2.2° at a full step; harder turns than half a step restart the
+# window and settle as before
+GENTLE_TURN_STEPS = 0.5
+REANCHOR_DEG = 10.0  # the window restarts past this change of heading (about 1° of lag each turn adds)
 _AXES = (dp.ChannelName.ROLL, dp.ChannelName.PITCH)
 _SENSE = {dp.CommandName.MOVE_RIGHT: (dp.ChannelName.ROLL, 1.0), dp.CommandName.MOVE_LEFT: (dp.ChannelName.ROLL, -1.0),
           dp.CommandName.MOVE_FORWARD: (dp.ChannelName.PITCH, 1.0),
           dp.CommandName.MOVE_BACKWARD: (dp.ChannelName.PITCH, -1.0)}
 _LEAN = {axis_sense: name for name, axis_sense in _SENSE.items()}  # (axis, sense) -> the command that leans so
+# a turn gives its frame to the lean owed once the debt is at its cap: tracking a drifting drone's target turns in
+# every frame, and the drift then has its way while the pilot turns after it
+_YIELDING = frozenset({dp.CommandName.TURN_LEFT, dp.CommandName.TURN_RIGHT})
 _STICK_TARGETS = frozenset(c.value for c in dp.ChannelName)  # a command of these targets sets a stick
 
 
@@ -46,16 +60,21 @@ class Drift:
         self.right = 0.0
         self.forward = 0.0
         self._lateral: deque[tuple[float, float]] = deque()
+        self._ref_deg = 0.0  # the heading the window's offsets are measured across
 
     def heading_moved(self) -> None:
-        """A turn or a pan step: the lateral offsets before it are from another heading."""
+        """The lateral offsets so far are from another reference heading (or the target was lost)."""
         self._lateral.clear()
 
-    def see(self, t: float, range_m: float, bearing_deg: float) -> None:
-        """A sighting: the target's range and its bearing from the body's axis (right positive)."""
+    def see(self, t: float, range_m: float, bearing_deg: float, heading_deg: float = 0.0) -> None:
+        """A sighting: the target's range and its bearing from the body's axis (right positive), the body's heading
+        then (reckoned, clockwise positive): the offset is across the line of sight at the window's first heading."""
         if range_m <= 0.0 or not math.isfinite(range_m):
             return
-        self._lateral.append((t, range_m * math.sin(math.radians(bearing_deg))))
+        if not self._lateral or abs(heading_deg - self._ref_deg) > REANCHOR_DEG:
+            self._lateral.clear()
+            self._ref_deg = heading_deg
+        self._lateral.append((t, range_m * math.sin(math.radians(bearing_deg + heading_deg - self._ref_deg))))
         while self._lateral and t - self._lateral[0][0] > LATERAL_WINDOW_S:
             self._lateral.popleft()
 
@@ -112,7 +131,8 @@ class TrimSticks:
         if command is None:
             return frame
         own = True
-        if command.name is dp.CommandName.HOLD_ALTITUDE:
+        saturated = max(abs(axis.owed) for axis in self._axes.values()) >= DEBT_MAX_DEG_S
+        if command.name is dp.CommandName.HOLD_ALTITUDE or (saturated and command.name in _YIELDING):
             name = max(_AXES, key=lambda a: abs(self._axes[a].owed + wanted[a] * dt))
             due = self._axes[name].owed + wanted[name] * dt
             if abs(due) >= PAY_MIN_DEG_S and dt > 0.0:
@@ -164,8 +184,10 @@ def _clamp(value: float, limit: float) -> float:
     return max(-limit, min(limit, value))
 
 
-_HEADING_MOVERS = frozenset({dp.CommandName.TURN_LEFT, dp.CommandName.TURN_RIGHT, dp.CommandName.SERVO_LEFT,
-                             dp.CommandName.SERVO_RIGHT, dp.CommandName.SERVO_RESET})
+_TURNS = frozenset({dp.CommandName.TURN_LEFT, dp.CommandName.TURN_RIGHT})  # the body's heading moves
+# the camera's pan moves: the bearing from the body (the pan included) is the same before and after, but the frames
+# of the next ``SETTLE_MS`` show the old pan or the slew (30-120 ms old, the servo at 0.1-0.2 s per 60°)
+_PANS = frozenset({dp.CommandName.SERVO_LEFT, dp.CommandName.SERVO_RIGHT, dp.CommandName.SERVO_RESET})
 
 
 class DriftHold:
@@ -174,8 +196,24 @@ class DriftHold:
     def __init__(self, pulses: StickModel, max_pulse_deg: float) -> None:
         self.drift = Drift()
         self.sticks = TrimSticks(pulses, max_pulse_deg)
-        self._moved_ms = -SETTLE_MS  # when the heading (or the pan) last moved
+        self._pulses = pulses
+        self._moved_ms = -SETTLE_MS  # when the pan last moved
         self._last_ms: int | None = None
+        self.heading_deg = 0.0  # reckoned from the yaw commands sent
+        self._yaw_dps = 0.0  # the yaw rate the firmware's stick holds ...
+        self._yaw_until_ms = 0  # ... until its command timeout
+        self._headings: deque[tuple[int, float]] = deque()  # (ms, heading) over the last FRAME_AGE_S
+
+    def _reckon(self, now_ms: int, dt: float) -> float:
+        """Advance the reckoned heading; the heading the present frame shows (``FRAME_AGE_S`` ago)."""
+        if dt > 0.0 and self._last_ms is not None:
+            held_s = max(0.0, min(now_ms, self._yaw_until_ms) - self._last_ms) / 1000.0
+            self.heading_deg += self._yaw_dps * min(dt, held_s)
+        self._headings.append((now_ms, self.heading_deg))
+        shown = now_ms - round(1000.0 * FRAME_AGE_S)
+        while len(self._headings) > 1 and self._headings[1][0] <= shown:
+            self._headings.popleft()
+        return self._headings[0][1]
 
     def step(self, frame: bytes | None, now_ms: int, sighting: tuple[float, float] | None,
              closing: float | None, apply: bool) -> bytes | None:
@@ -183,12 +221,13 @@ class DriftHold:
         measured; ``closing``: its closing speed (m/s) where the pilot commands no approach; ``apply``: lean
         against the drift in this state (else the frame goes as it is)."""
         dt = 0.0 if self._last_ms is None else max(0.0, (now_ms - self._last_ms) / 1000.0)
+        shown_deg = self._reckon(now_ms, dt)
         self._last_ms = now_ms
         sideways = None
         if sighting is None:
-            self.drift.heading_moved()
+            self.drift.heading_moved()  # not seen: a loss, a cover, a frame the target was not confirmed in
         elif now_ms - self._moved_ms >= SETTLE_MS:
-            self.drift.see(now_ms / 1000.0, *sighting)
+            self.drift.see(now_ms / 1000.0, sighting[0], sighting[1], shown_deg)
             sideways = self.drift.sideways
         self.drift.learn(sideways, closing, dt)
         if apply:
@@ -198,11 +237,25 @@ class DriftHold:
         else:
             self.sticks.reset()
             self.sticks.sent(frame, now_ms)
-        command = _decode_any(frame)
-        if command is not None and command.name in _HEADING_MOVERS:
+        self._held(_decode_any(frame), now_ms)
+        return frame
+
+    def _held(self, command: dp.Command | None, now_ms: int) -> None:
+        """What the yaw stick holds after the frame sent, and when the pan moved."""
+        if command is None:
+            return
+        if command.name in _PANS:
             self._moved_ms = now_ms
             self.drift.heading_moved()
-        return frame
+        elif command.name in _TURNS:
+            rate = self._pulses.turn_dps(command.value - dp.CHANNELS[dp.ChannelName.YAW].median)
+            self._yaw_dps = rate if command.name is dp.CommandName.TURN_RIGHT else -rate
+            if rate > GENTLE_TURN_STEPS * self._pulses.unit_turn_dps:
+                self._moved_ms = now_ms  # a hard turn: the reckoning is not trusted across it
+                self.drift.heading_moved()
+            self._yaw_until_ms = now_ms + dp.COMMAND_TIMEOUT_MS
+        elif dp.COMMANDS[command.name].target in _STICK_TARGETS or command.name is dp.CommandName.HOLD_ALTITUDE:
+            self._yaw_dps = 0.0
 
 
 def _decode_any(frame: bytes | None) -> dp.Command | None:

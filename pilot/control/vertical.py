@@ -8,7 +8,8 @@ flight but holds over the few seconds between a sighting and its loss, which is 
 ``SeenFrom`` remembers the height of the last measured sighting. A target lost after the drone climbed above that
 height sets a ceiling just below it (a floor, after a descent): the search starts back at the height it was seen
 from, and TRACK approaches without crossing the limit, the target off the frame's centre (AIM centres it with the
-tilt servo). A target that leaves the middle of the frame is followed across the limit all the same.
+tilt servo). ``APPROACH_FLOOR_M`` is such a floor always: a low target is approached from above the furniture
+beside it. A target that leaves the middle of the frame is followed across a limit all the same.
 """
 
 from __future__ import annotations
@@ -19,6 +20,10 @@ MARGIN_M = 0.1  # a limit this far inside the height last seen from
 MOVED_M = 0.03  # lost this far from the height last seen from: the climb (or descent) hid it
 MIN_LIMIT_M = 0.4  # no ceiling this low (seen from the ground, lost on take-off: no reason to fly that low)
 KEEP_IN_VIEW = 0.5  # a limit holds only while the target's vertical error is within this (of half the frame)
+# TRACK descends no lower than this towards a low target (AIM tilts the camera down to it): below about 0.5 m the
+# props' wash reads on the barometer AltHold holds (ArduCopter's baro ground effect, the EKF's EK3_GND_EFF_DZ), and
+# the furniture a low target stands among is as tall as it (a coffee table, a seat: 0.4-0.5 m)
+APPROACH_FLOOR_M = 0.6
 
 
 class Height:
@@ -84,4 +89,4 @@ class SeenFrom:
             return False
         if up:
             return self.ceiling_m is not None and height_m >= self.ceiling_m
-        return self.floor_m is not None and height_m <= self.floor_m
+        return height_m <= APPROACH_FLOOR_M or (self.floor_m is not None and height_m <= self.floor_m)

@@ -14,7 +14,7 @@ from controller_rig import CFG, name, seen, size_at, to_state
 from pilot.control.approach import Lead
 from pilot.control.controller import State
 from pilot.control.pulses import StickModel
-from pilot.control.trim import SETTLE_MS, Drift, DriftHold, TrimSticks
+from pilot.control.trim import DEBT_MAX_DEG_S, FRAME_AGE_S, LATERAL_WINDOW_S, Drift, DriftHold, TrimSticks
 
 PULSES = StickModel()
 ROLL, PITCH = dp.ChannelName.ROLL, dp.ChannelName.PITCH
@@ -97,12 +97,41 @@ def test_the_hold_learns_only_from_sightings_at_a_settled_heading_and_applies_on
         t += 50
     assert hold.drift.right < 0.0  # learnt: lean left
     assert lean_of(frame)[0] < 0.0 or lean_of(frame)[1] != 0.0
-    hold.step(dp.turn_right(1624), t, None, None, True)  # a turn: the heading moves
-    learnt = hold.drift.right
-    for k in range(1, SETTLE_MS // 50):
-        hold.step(dp.turn_right(1624), t + 50 * k, (3.0, 5.0 - 20.0 * k), None, True)
-    assert hold.drift.right == learnt  # no sighting counted while the heading moved
-    assert hold.step(dp.hold_altitude(), t + SETTLE_MS, None, None, False) == dp.hold_altitude()
+    assert hold.step(dp.hold_altitude(), t, None, None, False) == dp.hold_altitude()
+
+
+def _turning_past(hold: DriftHold, slide_mps: float) -> float:
+    """Two seconds of a drone turning right at a quarter step for 0.4 s in every second, the target 3 m away at a
+    fixed place, the drone sliding ``slide_mps`` to the right; each frame shows the heading ``FRAME_AGE_S`` ago."""
+    rate = PULSES.turn_dps(PULSES.unit_us(dp.ChannelName.YAW, True) / 4.0)
+    turn = dp.turn_right(round(dp.CHANNELS[dp.ChannelName.YAW].median + PULSES.unit_us(dp.ChannelName.YAW, True) / 4))
+    heading: list[float] = [0.0]
+    for k in range(40):
+        t = 50 * k
+        turning = k % 20 < 8
+        shown = heading[max(0, k - round(FRAME_AGE_S / 0.05))]
+        lateral = 0.2 - slide_mps * t / 1000.0  # across the line of sight at heading 0
+        bearing = math.degrees(math.asin(lateral / 3.0)) - shown
+        hold.step(turn if turning else dp.hold_altitude(), t, (3.0, bearing), None, False)
+        heading.append(heading[-1] + (rate * 0.05 if turning else 0.0))
+    return hold.drift.right
+
+
+def test_a_turn_is_reckoned_so_that_only_a_sliding_drone_teaches_a_trim() -> None:
+    """The target's bearing moves with the pilot's own turns: the reckoned heading takes them out, and only the
+    drone's sideways slide is learnt (leaning left against a slide to the right)."""
+    assert abs(_turning_past(DriftHold(PULSES, 5.0), 0.0)) < 0.02
+    assert _turning_past(DriftHold(PULSES, 5.0), 0.3) < -0.1
+
+
+def test_a_turn_gives_its_frame_to_a_lean_owed_up_to_its_cap() -> None:
+    """Tracking a drifting drone's target turns in every frame: once the lean owed reaches its cap, a turn frame
+    carries the lean instead, and the turns go on after it."""
+    sticks = TrimSticks(PULSES, 5.0)
+    frames = [sticks.shape(dp.turn_left(1474), 50 * k, -0.6, 0.0, 0.0) for k in range(60)]
+    leans = [k for k, f in enumerate(frames) if lean_of(f)[0] < 0.0]
+    assert leans and leans[0] * 0.05 * 0.6 >= DEBT_MAX_DEG_S - 0.05  # not before the cap
+    assert len(leans) < 10 and sum(lean_of(f)[0] for f in frames[20:]) / 40 == pytest.approx(-0.6, abs=0.15)
 
 
 def test_the_lead_is_what_the_recent_pitch_added() -> None:
@@ -127,8 +156,11 @@ def test_aiming_at_a_target_that_slides_left_leans_left_in_the_holds() -> None:
     the left and its holds carry it as roll; a still target teaches nothing."""
     c, rig = to_state(State.AIM, dataclasses.replace(CFG, aim_frames=1000))
     assert c.drift.drift.right == 0.0
+    for _ in range(round(LATERAL_WINDOW_S / 0.05)):  # the rig's target jumps to the centre: the window forgets it
+        rig.tick(seen(ex=0.0, size=0.2))
+    learnt = c.drift.drift.right
     frames = [rig.tick(seen(ex=0.0, size=0.2)) for _ in range(40)]
-    assert abs(c.drift.drift.right) < 0.01 and all(name(f) != "move_left" for f in frames if f is not None)
+    assert abs(c.drift.drift.right - learnt) < 0.005 and all(name(f) != "move_left" for f in frames if f is not None)
     c, rig = to_state(State.AIM, dataclasses.replace(CFG, aim_frames=1000))
     frames = [rig.tick(seen(ex=0.02 - 0.002 * k, size=0.2)) for k in range(40)]
     assert c.drift.drift.right < -0.02

@@ -7,7 +7,7 @@ import pytest
 from controller_rig import CFG, MISS, name, seen, st, to_state
 
 from pilot.control.controller import State
-from pilot.control.vertical import KEEP_IN_VIEW, MARGIN_M, MIN_LIMIT_M, Height, SeenFrom
+from pilot.control.vertical import APPROACH_FLOOR_M, KEEP_IN_VIEW, MARGIN_M, MIN_LIMIT_M, Height, SeenFrom
 
 
 def test_the_height_follows_the_throttle_stick_with_a_lag() -> None:
@@ -89,3 +89,12 @@ def test_the_throttle_estimate_ignores_servo_and_laser_frames() -> None:
         rig.tick(seen(0.0, 0.3, size=0.25))  # servo steps
     assert c.height.settles_m == pytest.approx(before, abs=1e-6)
     assert CFG.climb_mps_per_step > 0.0
+
+
+def test_a_low_target_is_approached_from_above_the_floor_height() -> None:
+    """Never seen lower: TRACK still descends no lower than ``APPROACH_FLOOR_M`` towards a low target (AIM tilts
+    down to it), unless the target is about to leave the frame's bottom."""
+    s = SeenFrom()
+    assert s.barred(False, APPROACH_FLOOR_M, 0.3) and s.barred(False, APPROACH_FLOOR_M - 0.2, 0.3)
+    assert not s.barred(False, APPROACH_FLOOR_M + 0.05, 0.3) and not s.barred(True, APPROACH_FLOOR_M, -0.3)
+    assert not s.barred(False, APPROACH_FLOOR_M, KEEP_IN_VIEW + 0.1)
