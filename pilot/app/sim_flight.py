@@ -127,6 +127,7 @@ class FlightJob:
     gusts: float = 0.0
     fault: str | None = None  # a camera fault, KIND@START+DURATION (world.CameraFault)
     ideal: bool = False  # the randomised world's effects off (pilot/sim/randomise.py)
+    record_dir: str | None = None  # the flight's video and log (as `pilot --record`)
 
 
 def sim_link(
@@ -302,6 +303,7 @@ def _fly_job(job: FlightJob) -> FlightResult:
         gusts=job.gusts,
         fault=job.fault,
         ideal=job.ideal,
+        record_dir=job.record_dir,
     )
 
 

@@ -32,9 +32,18 @@ SEED = 3
 REQUIRED = 11
 
 
+RECORDED = "side"  # the dozen's flight that also records its video and log (test_recording)
+
+
 @pytest.fixture(scope="module")
-def flights(virtual_drone: Path) -> list[FlightResult]:
-    jobs = [FlightJob(name, SEED, "hsv", executable=str(virtual_drone), ideal=True) for name in HSV_DOZEN]
+def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return tmp_path_factory.mktemp("recording")
+
+
+@pytest.fixture(scope="module")
+def flights(virtual_drone: Path, recording: Path) -> list[FlightResult]:
+    jobs = [FlightJob(name, SEED, "hsv", executable=str(virtual_drone), ideal=True,
+                      record_dir=str(recording) if name == RECORDED else None) for name in HSV_DOZEN]
     jobs += [FlightJob(name, SEED, "aruco", width=640, height=480, executable=str(virtual_drone), ideal=True)
              for name in ARUCO_PAIR]
     results = fly_many(jobs, processes=2)
@@ -88,27 +97,27 @@ def test_no_flight_lights_anything_else_touches_a_wall_or_crashes(flights: list[
 
 
 def test_a_flight_is_deterministic_for_its_seed(virtual_drone: Path) -> None:
-    a = fly("distractor", 7, executable=virtual_drone, max_seconds=12.0, ideal=True)
-    b = fly("distractor", 7, executable=virtual_drone, max_seconds=12.0, ideal=True)
-    c = fly("distractor", 8, executable=virtual_drone, max_seconds=12.0, ideal=True)
+    a = fly("distractor", 7, executable=virtual_drone, max_seconds=5.0, ideal=True)
+    b = fly("distractor", 7, executable=virtual_drone, max_seconds=5.0, ideal=True)
+    c = fly("distractor", 8, executable=virtual_drone, max_seconds=5.0, ideal=True)
     key = ("frames_sent", "sim_seconds", "min_distance", "longest_on_target_ms", "failures", "reason")
     assert [getattr(a, k) for k in key] == [getattr(b, k) for k in key]
     assert [getattr(a, k) for k in key] != [getattr(c, k) for k in key]
 
 
-def test_recording(virtual_drone: Path, tmp_path: Path) -> None:
+def test_recording(flights: list[FlightResult], recording: Path) -> None:
     import json
 
     import cv2
 
-    r = fly("side", 3, record_dir=tmp_path, executable=virtual_drone, ideal=True)
+    (r,) = (r for r in flights if r.scenario == RECORDED and r.detector == "hsv")
     assert r.success
     assert r.video and Path(r.video).stat().st_size > 10_000
     cap = cv2.VideoCapture(r.video)
     frames = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
     cap.release()
     assert frames > 100
-    lines = [json.loads(line) for line in (tmp_path / "log.jsonl").read_text().splitlines()]
+    lines = [json.loads(line) for line in (recording / "log.jsonl").read_text().splitlines()]
     states = {d["state"] for d in lines if "state" in d}
     assert {"arm", "search", "track", "fire", "land"} <= states
     assert any(d.get("link") == "tx" for d in lines) and any(d.get("link") == "rx" for d in lines)
