@@ -113,24 +113,36 @@ def _fields_table() -> tuple[tuple[_Fields | None, ...], ...]:
 
 _FIELDS: Final = _fields_table()
 # The value's digits by table: _NO_DIGIT outweighs them all, so a sum with one in it is below every range (values
-# are unsigned).
+# are unsigned). The tables stop at '9': a byte above it is an IndexError (no cost where none is raised), and so is
+# every byte until the first frame that needs the tables builds them (import stays the work it was).
 _NO_DIGIT: Final = -10000
+_Table = tuple[tuple[int, ...], ...]
+_PAIR0: _Table = ()  # digits 0 and 1 of the value, times 100
+_PAIR1: _Table = ()  # digits 2 and 3 of the value, times 1
 
 
-def _pairs(weight: int) -> tuple[tuple[int, ...], ...]:
-    """By two bytes: the value of their two digits times `weight`, or _NO_DIGIT. Two tuple indexings and an
-    addition per pair of digits cost about a third of `bytes.isdigit()` and `int()` of the digits' slice. Built
-    with few temporaries: each is work at import, and the collector walks the tables once."""
-    none: tuple[int, ...] = (_NO_DIGIT,) * 256
-    head, tail = none[:48], none[58:]
-    rows = [none] * 256
-    for d in range(10):
-        rows[48 + d] = head + tuple(range(10 * d * weight, (10 * d + 10) * weight, weight)) + tail
-    return tuple(rows)
+def _pairs(weight: int) -> _Table:
+    """By two bytes up to '9': the value of their two digits times `weight`, or _NO_DIGIT. Two tuple indexings and
+    an addition per pair of digits cost about a third of `bytes.isdigit()` and `int()` of the digits' slice."""
+    none: tuple[int, ...] = (_NO_DIGIT,) * 48
+    return (none + none[:10],) * 48 + tuple(none + tuple(range(10 * d * weight, (10 * d + 10) * weight, weight))
+                                           for d in range(10))
 
 
-_PAIR0: Final = _pairs(100)  # digits 0 and 1 of the value
-_PAIR1: Final = _pairs(1)  # digits 2 and 3 of the value
+def _digits(frame: bytes) -> int:
+    """The value of the frame's digits (bytes 2 to FRAME_LENGTH - 1), or _NO_DIGIT where one is no digit; builds
+    the tables first if they are not."""
+    global _PAIR0, _PAIR1
+    if not _PAIR0:
+        _PAIR0 = _pairs(100)
+        _PAIR1 = _pairs(1)
+    _, _, d0, d1, d2, d3 = frame
+    try:
+        return _PAIR0[d0][d1] + _PAIR1[d2][d3]
+    except IndexError:
+        return _NO_DIGIT
+
+
 # Decoded frames, by wire frame: Command is immutable, and a pilot sends few distinct frames. Its entries are
 # objects the cyclic collector tracks: bounded below the collector's first threshold (700 new objects), the memo
 # alone never makes it run (at 1024, decoding new frames ran it for about 800 instructions a frame).
@@ -144,7 +156,10 @@ def valid(frame: bytes) -> Command | None:
     fields = _FIELDS[first][second]
     if fields is not None:
         category, direction, name, minimum, maximum = fields
-        value = _PAIR0[d0][d1] + _PAIR1[d2][d3]  # below 0 unless every byte is a digit
+        try:
+            value = _PAIR0[d0][d1] + _PAIR1[d2][d3]  # below 0 unless every byte is a digit
+        except IndexError:  # a byte above '9', or the tables are not built yet
+            value = _digits(frame)
         if minimum <= value <= maximum:
             command = _new(Command, (category, direction, value, name))
             if len(DECODED) >= _DECODED_MAX:
@@ -160,6 +175,8 @@ def complete(frames: list[bytes], commands: list[Command | None]) -> int:
     index of the first frame that is not valid, or len(frames)."""
     first = commands.index(None)
     missing = commands.count(None)
+    if not _PAIR0:
+        _digits(frames[first])  # builds the tables
     if len(DECODED) + missing > _DECODED_MAX:  # the memo's bound, checked once for the chunk
         DECODED.clear()
     memo = DECODED if missing <= _DECODED_MAX else {}  # more new frames than it holds: remembered for this chunk
@@ -173,7 +190,7 @@ def complete(frames: list[bytes], commands: list[Command | None]) -> int:
                 if fields is None:
                     return k
                 category, direction, name, minimum, maximum = fields
-                value = _PAIR0[d0][d1] + _PAIR1[d2][d3]
+                value = _PAIR0[d0][d1] + _PAIR1[d2][d3]  # digits: the pattern says so
                 if not minimum <= value <= maximum:
                     return k
                 command = memo[frame] = _new(Command, (category, direction, value, name))
@@ -245,7 +262,10 @@ def decode(frame: BytesLike) -> Command:
         fields = _FIELDS[first][second]
         if fields is not None:
             category, direction, name, minimum, maximum = fields
-            value = _PAIR0[d0][d1] + _PAIR1[d2][d3]  # below 0 unless every byte is a digit
+            try:
+                value = _PAIR0[d0][d1] + _PAIR1[d2][d3]  # below 0 unless every byte is a digit
+            except IndexError:  # a byte above '9', or the tables are not built yet
+                value = _digits(frame)
             if minimum <= value <= maximum:
                 command = _new(Command, (category, direction, value, name))
                 if len(DECODED) >= _DECODED_MAX:

@@ -31,12 +31,13 @@ def _any_of(codes: Iterable[int]) -> bytes:
                            b"".join(re.escape(bytes([c])) for c in r) for r in out if r) + b"]"
 
 
-# Frame-shaped bytes: a category, a direction of any category, digits. Splitting the data at them
-# gives the garbage before each, the frames and the rest at C speed; the frames are then checked (a direction of
-# another category makes one invalid, as a value out of range does). Classes, not one alternative per category: the
-# engine skips the bytes that start no frame either way, checks a class in one step, and compiles it faster.
-_SHAPE = re.compile(b"(" + _any_of(BY_BYTES) + _any_of(set().union(*BY_BYTES.values()))
-                    + b"[0-9]" * (FRAME_LENGTH - 2) + b")")
+
+# One alternative per category, each starting with its byte: the regular expression engine skips the bytes that
+# start no frame at C speed, and tries the alternatives only where one may start.
+_PAIR = b"|".join(re.escape(bytes([c])) + _any_of(d) for c, d in BY_BYTES.items())
+# Frame-shaped bytes: a category, one of its directions, digits. Splitting the data at them gives
+# the garbage before each, the frames and the rest at C speed; the frames are then checked.
+_SHAPE = re.compile(b"((?:" + _PAIR + b")" + b"[0-9]" * (FRAME_LENGTH - 2) + b")")
 # Garbage is counted by kind at C speed: every byte not a category is a bad category (bytes.translate() deletes
 # the categories), every category a bad direction unless one of its directions follows; only there does problem()
 # say more. The garbage before the frames of a chunk is searched as one, each piece followed by _SEP, a byte that is
@@ -159,7 +160,7 @@ class StreamDecoder:
             if categories:
                 self._recount(data, joined, garbage)
             i = total + kept * WIRE_LENGTH
-        if kept < len(frames):  # frame-shaped, but not valid: one error at its start, then byte by byte
+        if kept < len(frames):  # frame-shaped, but out of range: one error at its start, then byte by byte
             if last:
                 self._count(data, i, i + len(last))
                 i += len(last)
