@@ -173,18 +173,19 @@ def complete(frames: list[bytes], commands: list[Command | None]) -> int:
     """Fill in the None entries of `commands` (DECODED's answers for `frames`, frame-shaped bytes of WIRE_LENGTH:
     digits where the value goes) with valid()'s, written out: a call per frame cost more than its body. Return the
     index of the first frame that is not valid, or len(frames)."""
-    first = commands.index(None)
+    start = commands.index(None)
     missing = commands.count(None)
     if not _PAIR0:
-        _digits(frames[first])  # builds the tables
+        _digits(frames[start])  # builds the tables
     if len(DECODED) + missing > _DECODED_MAX:  # the memo's bound, checked once for the chunk
         DECODED.clear()
     memo = DECODED if missing <= _DECODED_MAX else {}  # more new frames than it holds: remembered for this chunk
-    for k in range(first, len(frames)):  # a loop step per frame cost less than an index() call per new one
+    for k in range(start, len(frames)):  # a loop step per frame cost less than an index() call per new one
         if commands[k] is None:
             frame = frames[k]
-            command = memo.get(frame)  # a repeat of a frame decoded earlier in this data
-            if command is None:
+            if frame in memo:  # a repeat of a frame decoded earlier in this data (`in` costs less than get())
+                command = memo[frame]
+            else:
                 first, second, d0, d1, d2, d3 = frame
                 fields = _FIELDS[first][second]
                 if fields is None:
