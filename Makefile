@@ -72,8 +72,10 @@ pytest: deps pythons
 
 # After pytest, the native targets' own tests (fuzz-smoke here; targets.mk and typescript.mk add theirs to TEST_TAIL)
 # run two at a time: each is one process for most of its time, and they build into folders of their own.
+# The type check (one process, about 50 s cold) runs beside pytest: alone before it, it left a core idle.
 TEST_TAIL := fuzz-smoke
-test: deps check-generated lint typecheck pytest
+test: deps check-generated lint
+	@$(MAKE) --no-print-directory -j2 --output-sync=target typecheck pytest
 	@$(MAKE) --no-print-directory -j2 --output-sync=target $(TEST_TAIL)
 
 demo: deps generate

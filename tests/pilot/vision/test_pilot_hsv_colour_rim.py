@@ -63,13 +63,13 @@ def test_a_busy_inside_takes_no_colour_rim(r: int, monkeypatch: pytest.MonkeyPat
     assert rim_support(img, CX, CY, r, colour=True) >= COLOUR_MIN
 
 
-@pytest.mark.parametrize("seed", [61, 65])
 def test_jpeg_views_give_more_balls_with_the_colour_rim_or_the_dome_and_no_more_detections_in_empty_views(
-        seed: int, monkeypatch: pytest.MonkeyPatch) -> None:
-    """On these seeds (not bench/vision's), of 300 balls: 274 and 272 with neither the colour rim nor the circle
-    look's domed circles (hsv/dome.py), 277 and 275 with the colour rim alone, 278 and 274 with the domed
-    circles alone, 280 and 275 with both (most balls the colour rim finds have a brightness rim of 0.7-0.8 and are
-    domed too); 1 and 0 of 200 empty views with a detection in every case."""
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """On this seed (not bench/vision's), of 300 balls: 274 with neither the colour rim nor the circle look's
+    domed circles (hsv/dome.py), 277 with the colour rim alone, 278 with the domed circles alone, 280 with both
+    (most balls the colour rim finds have a brightness rim of 0.7-0.8 and are domed too); 1 of 200 empty views with
+    a detection in every case. (Seed 65 gave 272 / 275 / 274 / 275 and 0; both seeds doubled the test's time.)"""
+    seed = 61
     views = ve.samples(vi.TUNING, seed, 300, 0, 0, "ball", (16.0, 120.0), ("jpeg",))
     rng = np.random.default_rng(seed + 1)
     views += [vi.empty_sample(rng, vi.TUNING, "jpeg") for _ in range(200)]
