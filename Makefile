@@ -67,8 +67,10 @@ pythons:
 	  >/dev/null 2>&1 || { command -v pyenv >/dev/null && pyenv install -s $$v; } || \
 	  { echo "Python $$v is missing: install pyenv (https://github.com/pyenv/pyenv) and run  pyenv install $$v"; exit 1; }; done
 
+# without make's own variables: under `make -j2` (make test) they name a jobserver the tests' own make calls cannot
+# reach, and those print a warning the tests read as output
 pytest: deps pythons
-	$(PY) -m pytest -q -n 2 --dist loadgroup --no-loadscope-reorder tests
+	env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL $(PY) -m pytest -q -n 2 --dist loadgroup --no-loadscope-reorder tests
 
 # After pytest, the native targets' own tests (fuzz-smoke here; targets.mk and typescript.mk add theirs to TEST_TAIL)
 # run two at a time: each is one process for most of its time, and they build into folders of their own.
