@@ -129,13 +129,18 @@ def _pairs(weight: int) -> _Table:
                                            for d in range(10))
 
 
+def _build_tables() -> None:
+    """The digit tables, built by the first frame that needs them."""
+    global _PAIR0, _PAIR1
+    _PAIR0 = _pairs(100)
+    _PAIR1 = _pairs(1)
+
+
 def _digits(frame: bytes) -> int:
     """The value of the frame's digits (bytes 2 to FRAME_LENGTH - 1), or _NO_DIGIT where one is no digit; builds
     the tables first if they are not."""
-    global _PAIR0, _PAIR1
     if not _PAIR0:
-        _PAIR0 = _pairs(100)
-        _PAIR1 = _pairs(1)
+        _build_tables()
     _, _, d0, d1, d2, d3 = frame
     try:
         return _PAIR0[d0][d1] + _PAIR1[d2][d3]
@@ -176,7 +181,7 @@ def complete(frames: list[bytes], commands: list[Command | None]) -> int:
     start = commands.index(None)
     missing = commands.count(None)
     if not _PAIR0:
-        _digits(frames[start])  # builds the tables
+        _build_tables()
     if len(DECODED) + missing > _DECODED_MAX:  # the memo's bound, checked once for the chunk
         DECODED.clear()
     memo = DECODED if missing <= _DECODED_MAX else {}  # more new frames than it holds: remembered for this chunk
