@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import os
 import select
+import shutil
+import tempfile
 import threading
 import time
 import tty
@@ -142,12 +144,16 @@ class FakeDrone:
 
 class PtyDrone:
     """The fake drone on the master side of a pseudo-terminal, in real time, for the real program: it
-    prints the ready line, answers every frame with its status, and can vanish (``unplug``)."""
+    prints the ready line, answers every frame with its status, and can vanish (``close``). The program
+    opens it by a name of its own, as a USB device node: the kernel hands a freed /dev/pts number to the next
+    pseudo-terminal, and a pilot reopening the old number could find another test's drone there."""
 
     def __init__(self) -> None:
         self.master, self.slave = os.openpty()
         tty.setraw(self.slave)
-        self.path = os.ttyname(self.slave)
+        self._dir = tempfile.mkdtemp(prefix="ptydrone-")
+        self.path = os.path.join(self._dir, "ttyACM0")
+        os.symlink(os.ttyname(self.slave), self.path)
         self.drone = FakeDrone(time.monotonic)
         self.wire = bytearray()
         self._stop = threading.Event()
@@ -181,8 +187,9 @@ class PtyDrone:
         return [dp.decode(data[i : i + dp.FRAME_LENGTH]).name for i in range(0, len(data), dp.FRAME_LENGTH)]
 
     def close(self) -> None:
-        """Also what a pulled cable does: both ends of the pseudo-terminal go away."""
+        """Also what a pulled cable does: the device's name and both ends of the pseudo-terminal go away."""
         self._stop.set()
+        shutil.rmtree(self._dir, ignore_errors=True)
         self._thread.join(timeout=2)
         if self._open:
             self._open = False
