@@ -1,5 +1,5 @@
 """The simulator's speed probe (bench/flight/speed.py): physics per tick of simulated time, render and sensor per
-frame, and a baseline that is not a checkout refused in one line."""
+frame, and a baseline that is not a checkout refused in one line; a campaign resumed from its log."""
 
 from __future__ import annotations
 
@@ -7,8 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from bench.flight.run import main
+from bench.flight.run import main, pending
 from bench.flight.speed import figures
+from pilot.app.sim_flight import FlightJob
 
 
 def test_physics_counts_per_tick_and_the_camera_per_frame() -> None:
@@ -27,3 +28,12 @@ def test_a_baseline_that_is_not_a_checkout_is_refused(tmp_path: Path, capsys: py
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert "--speed-baseline" in err and "not a checkout" in err
     assert not (tmp_path / "SPEED.md").exists()
+
+
+def test_a_resumed_campaign_flies_only_the_flights_its_log_lacks(tmp_path: Path) -> None:
+    todo = [FlightJob("ahead", 3019, "aruco"), FlightJob("behind", 3019, "aruco"), FlightJob("ahead", 3019, "hsv"),
+            FlightJob("ahead", 4019, "hsv", gusts=0.5)]
+    log = tmp_path / "held-out.jsonl"
+    log.write_text('{"scenario": "ahead", "seed": 3019, "detector": "aruco", "gusts": 0.0}\n\n'
+                   '{"scenario": "ahead", "seed": 4019, "detector": "hsv", "gusts": 0.5}\n')
+    assert pending(todo, log) == todo[1:3]
