@@ -149,9 +149,14 @@ def _from_spec() -> dict[str, float]:
 
 
 def load(parm: Path | None = REPO_PARM, overrides: Mapping[str, float] | None = None) -> SimParams:
+    """The parameters of ``parm`` over ArduCopter's defaults; ``parm=None``: the codec's channel table only. A
+    parameter file that is missing is an error, never a quiet fallback to another flight controller."""
     data: dict[str, Any] = yaml.safe_load(PARAMS_YAML.read_text(encoding="utf-8"))
     values: dict[str, float] = {k: float(v) for k, v in data["arducopter"].items()}
-    if parm is not None and parm.is_file():
+    if parm is not None:
+        if not parm.is_file():
+            raise ConfigError(f"simulator parameters: the flight controller's parameter file {parm} is missing "
+                              "(in a checkout, `python -m generator` writes it; a wheel carries it)")
         values |= read_parm(parm)
         source = str(parm)
     else:

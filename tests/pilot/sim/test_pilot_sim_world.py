@@ -53,6 +53,9 @@ def test_a_flight_controller_or_airframe_figure_outside_its_range_is_refused(tmp
     monkeypatch.setattr(rc, "PARAMS_YAML", tmp_path / "arducopter.yaml")
     with pytest.raises(ConfigError, match=r"simulator parameter airframe.mass_kg = -1.5 .*physical range"):
         rc.load()
+    # a copy of the code without the generated parameter file flies no other flight controller in silence
+    with pytest.raises(ConfigError, match=r"parameter file .*drone\.parm is missing"):
+        rc.load(tmp_path / "drone.parm")
 
 
 def test_a_spawn_or_target_inside_a_wall_or_furniture_is_refused_when_the_room_is_built() -> None:
