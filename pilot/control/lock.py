@@ -3,10 +3,10 @@
 The gate acquires a sighting at ``controller.acquire_confidence`` (``pilot/vision/gating.py``). A tracked ball's
 confidence dips under that for frames on end while nothing about it changes: big and low in the frame as the drone
 brakes near it (``ahead`` 3016: 0.52-0.58 at 1.4 m, in full view), partly behind a panel (``occluded`` 3018:
-0.3-0.6). Six such frames in a row were a loss, and the search then turned away from it. Kept: found, at
-``KEEP_SHARE`` of the acquire confidence at least, and steady against the frame before (``gating.steady``: size and
-centre). Only a lock is kept so: acquiring a sighting needs the full confidence, and the laser the gate's
-confirmation, as before.
+0.3-0.6; ``high`` 3011: 0.46-0.61 for a second on end). Six such frames in a row were a loss, and the search then
+turned away from it; an ACQUIRE that needed three frames in a row at the full confidence never had them. Kept: found,
+at ``KEEP_SHARE`` of the acquire confidence at least, and steady against the frame before (``gating.steady``: size
+and centre), after a frame acquired at the full confidence. The laser needs the gate's confirmation, as before.
 """
 
 from __future__ import annotations

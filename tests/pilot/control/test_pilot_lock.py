@@ -47,3 +47,12 @@ def test_a_kept_lock_never_lights_the_laser() -> None:
     for _ in range(4 * CFG.aim_frames):
         rig.tick(seen(0.0, size=CFG.approach_size * 1.05, confidence=WEAK))
         assert st(c) is State.AIM and not c.want_laser
+
+
+def test_a_sighting_acquired_once_is_confirmed_by_steady_frames_under_the_level() -> None:
+    c, rig = to_state(State.SEARCH)
+    rig.tick(seen(0.3, size=0.05))  # acquired at the full confidence: ACQUIRE
+    assert st(c) is State.ACQUIRE
+    for _ in range(CFG.acquire_frames - 1):  # then 0.46-0.6, the same ball (high 3011)
+        rig.tick(seen(0.3, size=0.05, confidence=WEAK))
+    assert st(c) is State.TRACK and c.transitions[-1].reason.startswith("seen in")
