@@ -22,10 +22,11 @@ from ..common.config import FIRE_RANGE_SHARE, ControllerConfig
 from ..vision.detection import Detection
 from ..vision.gating import Gate, centred
 from .approach import ClosingSpeed, Lead, Lean, Momentum, allowed_speed, brake_steps
-from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, turn_towards
+from .controller_core import FLYING, KEPT, LOCKED, ControllerCore, State, Transition, turn_towards
 from .descent import DESCENT_STEPS, Descent
+from .lock import Lock
 from .response import TurnResponse, turn_sense
-from .search import return_sense, sweep_sense
+from .search import Look, glimpse, return_sense, sweep_sense
 from .sticks import HeldSticks
 from .trim import DriftHold
 from .vertical import Height, SeenFrom
@@ -67,6 +68,7 @@ class Controller(ControllerCore):
         self.drift = DriftHold(self.pulses, self.cfg.unit_lean_deg)
         self._pitch_calm_ms = self._now()
         self.descent = Descent(self.cfg.climb_mps_per_step)  # LAND's own descent, before the firmware's routine
+        self.look, self.lock, self._sighted = Look(), Lock(), False  # _sighted: this frame's, the lock's kept too
 
     def _hold_range(self, det: Detection) -> bytes | None:
         """Near the target nothing holds position but the pilot: brake a closing speed, nudge forward against a
@@ -149,6 +151,7 @@ class Controller(ControllerCore):
     def _decide_frame(self, det: Detection | None) -> bytes | None:
         # -- vision gate (issue 12): a bad frame holds (laser off), too many in a row land ------------
         self.gate.observe(det)
+        self._sighted = self.lock.sighted(det, self.gate.acquired(), self.state in KEPT, self.cfg.acquire_confidence)
         if self.gate.fault is not None and self.state in FLYING - {State.TAKEOFF, State.HOLD}:
             if self.gate.fault_frames >= self.cfg.blind_frames:
                 off = self._laser(False)
@@ -160,7 +163,7 @@ class Controller(ControllerCore):
         return super()._decide(det)
 
     def _found(self, det: Detection | None) -> bool:
-        return det is not None and det.found and self.gate.acquired()  # vision gate: confident enough
+        return det is not None and det.found and self._sighted  # vision gate: confident enough (or kept)
 
     def _on_search(self, det: Detection | None) -> bytes | None:
         if self._found(det):
@@ -174,6 +177,9 @@ class Controller(ControllerCore):
         if self._pan_offset or self._tilt_offset:
             self._pan_offset = self._tilt_offset = 0
             return self._emit(dp.servo_reset())
+        if self.look.holds(self._now(), glimpse(det, self.cfg.acquire_confidence)):  # turn after it, gently
+            off = det.error_x if det is not None and det.found and abs(det.error_x) > self.cfg.dead_band_x else 0.0
+            return self._emit(turn_towards(off, self.pulses) if off else dp.hold_altitude())
         sense = self._height_move()
         if sense:
             return self._emit(dp.move_up(self._speed(dp.CommandName.MOVE_UP, 1.0)) if sense > 0 else
