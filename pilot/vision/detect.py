@@ -4,12 +4,11 @@ The pipeline (each part in its own module):
 
 1. ``pilot.vision.frames``: a malformed, black, saturated or frozen frame is named in ``Detection.status`` and
    goes no further.
-2. A single-frame detector lists scored candidates: ``pilot.vision.hsv.detector`` (a coloured ball) or
-   ``pilot.vision.aruco`` (a marker).
+2. A single-frame detector lists scored candidates: ``pilot.vision.hsv.detector`` (a coloured ball; its first few
+   candidates then pass ``pilot.vision.verify``'s learned veto) or ``pilot.vision.aruco`` (a marker).
 3. ``pilot.vision.tracking``: one track picks the candidate consistent with the last frames, rejects jumps and
    bridges a few missed frames. A target the pilot acts on that the frame's look misses first gets a closer
    look where the track expects it (``candidates_near``).
-   The colour-ball detector's candidates first pass ``pilot.vision.verify``'s learned veto.
 4. The controller's ``pilot.vision.gating.Gate`` turns confidences into "act on it" and "the laser may fire".
 """
 
