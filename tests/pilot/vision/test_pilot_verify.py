@@ -1,6 +1,6 @@
 """The learned ball verifier (pilot/vision/verify.py): the shipped model loads and passes the bench's ball, vetoed
 candidates never reach the tracker, at most ``MAX_VERIFIED`` are looked at, and a missing, truncated, corrupt or
-other-version model file is refused with one error naming it."""
+other-version model file is refused with one error naming it (by the pilot at start: one line, exit 2)."""
 
 from __future__ import annotations
 
@@ -8,9 +8,11 @@ import dataclasses
 import math
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pytest
 import vision_imagery as vi
+from cli_rig import call
 from cv2.typing import MatLike
 
 import pilot.vision.verify as verify
@@ -129,3 +131,21 @@ def test_bad_model_file_is_refused_naming_it(tmp_path: Path, damage: str) -> Non
     assert str(path) in message and "\n" not in message
     if damage in ("version", "features"):
         assert "99" in message and "make bench-verifier" in message
+
+
+def test_the_pilot_refuses_to_start_on_a_corrupt_verifier_in_one_line(tmp_path: Path,
+                                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    bad = tmp_path / "verifier.yaml"
+    bad.write_text(verify.MODEL.read_text(encoding="utf-8")[:5000], encoding="utf-8")
+    monkeypatch.setattr(verify, "MODEL", bad)
+    verify.shipped.cache_clear()
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    for k in range(2):
+        img, _, _ = ball_view(k, 40.0)
+        cv2.imwrite(str(folder / f"f{k}.png"), img)
+    try:
+        code, out, err = call("--images", str(folder), "--dry-run", "--no-status")
+    finally:
+        verify.shipped.cache_clear()  # the next test reads the shipped model again
+    assert code == 2 and str(bad) in err and len(err.strip().splitlines()) == 1 and "dry-run" not in out
