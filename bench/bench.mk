@@ -20,6 +20,10 @@
 #                         opencv-doc's photos and videos, matplotlib), split by source into tuning and held-out;
 #                         installs the bench extra (pip) and Debian's opencv-doc; about 10 minutes on 2 cores; writes
 #                         bench/vision/RESULTS-sources.md (BENCH_VISION_SOURCES_FLAGS="--views 20 --timing 20": smoke)
+#   make bench-verifier   trains the colour-ball detector's learned verifier on the tuning sources only (its
+#                         candidates on composites of the bench's ball: positives on the ball, negatives elsewhere),
+#                         chooses its threshold on a second seed set, writes pilot/vision/verifier.yaml; about
+#                         15 minutes on 2 cores (BENCH_VERIFIER_FLAGS="--views 40 --no-write": smoke)
 #   make bench-tools      the standalone codec wheel's size and import time vs json; the live view's frame
 #                         latency and the pilot loop's rate with and without a viewer; writes bench/tools/RESULTS.md
 #   make bench-flight     the closed-loop campaign in the MuJoCo simulator: seeded flights per detector across
@@ -42,11 +46,13 @@ BENCH_PROTOCOL_FLAGS ?=
 
 BENCH_VISION_FLAGS ?=
 BENCH_VISION_SOURCES_FLAGS ?=
+BENCH_VERIFIER_FLAGS ?=
 BENCH_VISION_APT := opencv-doc avr-libc  # the packaged imagery of bench-vision-sources (bench/vision/packaged.py)
 VISION_DEV_RECORD ?= current
 BENCH_FLIGHT_FLAGS ?=
 
 .PHONY: bench bench-protocol bench-generator bench-firmware bench-pilot bench-vision bench-vision-sources bench-vision-dev \
+        bench-verifier \
         bench-ide bench-tools bench-flight bench-flight-strict bench-sidechan
 
 # Run benchmarks one at a time (not with make -j): they time each other otherwise.
@@ -66,6 +72,10 @@ bench-flight-strict: deps firmware-host
 
 bench-vision: deps
 	PYTHONPATH=.:bench/vision $(PY) bench/vision/run.py $(BENCH_VISION_FLAGS)
+
+bench-verifier: deps
+	$(PY) -m pip install -q -e '.[bench]'
+	PYTHONPATH=.:bench/vision $(PY) bench/vision/train_verifier.py $(BENCH_VERIFIER_FLAGS)
 
 bench-vision-sources: deps
 	@missing=$$(for p in $(BENCH_VISION_APT); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null \

@@ -5,6 +5,8 @@ video's frames are reported as a set of their own. Per set: the colour detector'
 detections on empty, drawn-distractor and natural-distractor views (vision_imagery.py composes them, as for
 RESULTS.md), the gate on jittered sequences and on runs of real video frames (laser-on frames without the target),
 ArUco clean, motion-blurred and with a corner covered, and the cost per frame against the cvtColor+inRange floor.
+The colour detector's candidates pass the learned verifier (pilot/vision/verify.py) as the pilot runs them; its
+single-view figures are also given for the rules alone, from the same candidates.
 The accuracy runs freeze the budget's clock (the rules judged alone, the same on any machine's load); the cost runs
 keep the default budget (``vision.budget_ms``) on the wall clock, as the pilot flies.
 """
@@ -15,7 +17,7 @@ import argparse
 import platform
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import cv2
@@ -26,10 +28,13 @@ import sources_time as st
 import vision_eval as ve
 import vision_imagery as vi
 import vision_sequences as vs
+from cv2.typing import MatLike
 
 import pilot.vision.budget as budget
+import pilot.vision.verify as verify
 from pilot.common.config import ControllerConfig
 from pilot.vision.aruco import ArucoMarkerDetector
+from pilot.vision.detection import Candidate
 from pilot.vision.hsv.detector import HsvBlobDetector
 
 HERE = Path(__file__).resolve().parent
@@ -48,9 +53,26 @@ class Set:
 
 @dataclass
 class Result:
-    hsv: list[ve.Record]
+    hsv: list[ve.Record]  # the colour detector's candidates through the learned verifier, as the pilot runs it
     aruco: list[ve.Record]
     seqs: list[vs.Sequence]
+    rules: list[ve.Record] = field(default_factory=list)  # the same views, the rules alone (no verifier)
+
+
+def verified_records(views: list[vi.Sample]) -> tuple[list[ve.Record], list[ve.Record]]:
+    """The colour detector on ``views`` once: its records through the learned verifier and without it."""
+    det, verifier = HsvBlobDetector(), verify.shipped()
+    found: dict[int, list[Candidate]] = {}
+
+    def rules(image: MatLike) -> list[Candidate]:
+        found[id(image)] = det.candidates(image)
+        return found[id(image)]
+
+    def checked(image: MatLike) -> list[Candidate]:
+        return [c for c in found.pop(id(image))[: verify.MAX_VERIFIED] if verifier.passes(image, c)]
+
+    plain = ve.run(rules, views)
+    return ve.run(checked, views), plain
 
 
 def sets() -> list[Set]:
@@ -76,10 +98,10 @@ def evaluate(st_: Set, seed: int, n: int) -> Result:
         ball += [natural(vi.empty_sample(rng, (name,)), "distractor", "natural") for _ in range(n // 2)]
     markers = ve.samples(st_.names, seed + 1, n, 0, 0, "marker", (24.0, 120.0), ARUCO_GOALS)
     negatives = [s for s in ball if s.kind != "target"]
-    hsv = ve.run(HsvBlobDetector().candidates, ball)
+    hsv, rules = verified_records(ball)
     aruco = ve.run(ArucoMarkerDetector().candidates, markers + negatives)
     seqs = vs.sequences(st_.names, seed + 2, n // 20, n // 5, n // 40)
-    return Result(hsv, aruco, seqs)
+    return Result(hsv, aruco, seqs, rules)
 
 
 def natural(s: vi.Sample, kind: str, condition: str) -> vi.Sample:
@@ -92,12 +114,12 @@ def rate(records: list[ve.Record], kind: str, group: str | None, threshold: floa
     return (sum(ve.detected(r, threshold) for r in rs) / len(rs) if rs else float("nan")), len(rs)
 
 
-def hsv_rows(results: dict[str, Result], threshold: float) -> list[str]:
+def hsv_rows(results: dict[str, Result], threshold: float, rules: bool = False) -> list[str]:
     out = ["| set | " + " | ".join(CONDITIONS) + " | worst but occlusion |", "|---" * (len(CONDITIONS) + 2) + "|"]
     for label, r in results.items():
         if not r.hsv:
             continue
-        rows = {row.group: row for row in ve.target_rows(r.hsv, threshold, 16)}
+        rows = {row.group: row for row in ve.target_rows(r.rules if rules else r.hsv, threshold, 16)}
         worst = min(CONDITIONS[:-1], key=lambda c: rows[c].rate)
         out.append(f"| {label} | " + " | ".join(f"{pct(rows[c].rate)} ({rows[c].n})" for c in CONDITIONS)
                    + f" | {pct(rows[worst].rate)} ({worst}) |")
@@ -119,6 +141,24 @@ def false_rows(results: dict[str, Result], threshold: float) -> list[str]:
         out.append(f"| {label} | {pct(e)} of {ne} | {pct(dr)} of {len(d)} | "
                    f"{pct(nat) + f' of {nn}' if nn else '-'} | {pct(se)} of {sum(s.kind == 'empty' for s in r.seqs)} | "
                    f"{pct(sd)} of {sum(s.kind == 'distractor' for s in r.seqs)} | {laser} of {frames} |")
+    return out
+
+
+def rules_rows(results: dict[str, Result], threshold: float) -> list[str]:
+    """Empty and drawn-distractor views with a detection, the rules alone and through the verifier."""
+    out = ["| set | empty views, rules alone | with the verifier | drawn distractors, rules alone | with the verifier "
+           "| natural distractors, rules alone | with the verifier |", "|---|---|---|---|---|---|---|"]
+    for label, r in results.items():
+        if not r.hsv:
+            continue
+        cells = []
+        for kind, group in (("empty", None), ("distractor", "drawn"), ("distractor", "natural")):
+            for records in (r.rules, r.hsv):
+                rs = [x for x in records if x.kind == kind and (group is None or (x.group == "natural") == (
+                    group == "natural"))]
+                cells.append(f"{pct(sum(ve.detected(x, threshold) for x in rs) / len(rs))} of {len(rs)}" if rs
+                             else "-")
+        out.append(f"| {label} | " + " | ".join(cells) + " |")
     return out
 
 
@@ -176,8 +216,13 @@ def main(argv: list[str] | None = None) -> int:
             f"distractor kind (1-3 objects: {', '.join(vi.DISTRACTOR_KINDS)}), {args.views // 2} views of each "
             f"natural-distractor photo, every condition but occlusion applied to the views without a target. "
             f"Confidence threshold {threshold} (`controller.acquire_confidence`), budget's clock frozen.", "",
-            "## HSV recall, targets >= 16 px", "", *hsv_rows(results, threshold), "",
-            "## HSV detections without the target", "",
+            "## HSV recall, targets >= 16 px (candidates through the learned verifier, pilot/vision/verify.py)", "",
+            *hsv_rows(results, threshold), "",
+            "## HSV recall without the learned verifier (the rules alone, the same views)", "",
+            *hsv_rows(results, threshold, rules=True), "",
+            "## HSV detections on views without the target, without and with the verifier", "",
+            *rules_rows(results, threshold), "",
+            "## HSV detections without the target (with the verifier)", "",
             "Views: a detection at or above the threshold in one frame. Sequences: the whole pipeline (frame checks, "
             "detector, tracker) and the gate at the configured threshold and N, centring and range lifted; "
             f"photo sets: {args.views // 5} empty and {args.views // 40} per drawn-distractor kind of "

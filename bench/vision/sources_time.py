@@ -13,14 +13,16 @@ import numpy as np
 import timing_sources as ts
 
 from pilot.vision.hsv.detector import HsvBlobDetector
+from pilot.vision.verify import VerifiedSource, shipped
 
 SEED = 99
 
 
 def measure(names: tuple[str, ...], n: int, size: tuple[int, int], rng: np.random.Generator
             ) -> tuple[list[float], list[float], list[float], list[float], int]:
-    """Floor wall and CPU, detector wall and CPU (ms per frame), and the frames the budget cut short."""
-    det = HsvBlobDetector()
+    """Floor wall and CPU, detector wall and CPU (ms per frame; its candidates through the learned verifier, as
+    the pilot runs it), and the frames the budget cut short."""
+    det = VerifiedSource(HsvBlobDetector(), shipped())
     fw, fc, dw, dc, cut = [], [], [], [], 0
     for img in ts.frames(rng, names, n, size):
         w, c = ts.clocked(ts.floor, img)

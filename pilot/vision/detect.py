@@ -4,8 +4,8 @@ The pipeline (each part in its own module):
 
 1. ``pilot.vision.frames``: a malformed, black, saturated or frozen frame is named in ``Detection.status`` and
    goes no further.
-2. A single-frame detector lists scored candidates: ``pilot.vision.hsv.detector`` (a coloured ball) or
-   ``pilot.vision.aruco`` (a marker).
+2. A single-frame detector lists scored candidates: ``pilot.vision.hsv.detector`` (a coloured ball; its first few
+   candidates then pass ``pilot.vision.verify``'s learned veto) or ``pilot.vision.aruco`` (a marker).
 3. ``pilot.vision.tracking``: one track picks the candidate consistent with the last frames, rejects jumps and
    bridges a few missed frames. A target the pilot acts on that the frame's look misses first gets a closer
    look where the track expects it (``candidates_near``).
@@ -26,6 +26,7 @@ from .detection import CandidateSource, Detection, Detector, FrameStatus, range_
 from .frames import FrameCheck
 from .hsv.detector import HsvBlobDetector
 from .tracking import Tracker
+from .verify import VerifiedSource, shipped
 
 __all__ = [
     "ArucoMarkerDetector", "Detection", "Detector", "FrameStatus", "HsvBlobDetector", "TrackedDetector",
@@ -78,13 +79,18 @@ class TrackedDetector:
                          aim_on_target=aim, cut_short=cut)
 
 
-def make_detector(config: PilotConfig, clock: Callable[[], float] | None = None) -> TrackedDetector:
-    """``clock``: seconds, for the frame's budget (default ``pilot.vision.budget.CLOCK``, the wall clock)."""
+def make_detector(config: PilotConfig, clock: Callable[[], float] | None = None, verified: bool = True
+                  ) -> TrackedDetector:
+    """``clock``: seconds, for the frame's budget (default ``pilot.vision.budget.CLOCK``, the wall clock);
+    ``verified``: the colour-ball detector's candidates pass the learned verifier (``pilot.vision.verify``; False:
+    the rules alone, as the bench compares)."""
     fov = config.controller.horizontal_fov_deg
     source: CandidateSource
     if config.detector == "hsv":
         ball = SimpleBallDetector if config.hsv.simple else HsvBlobDetector
         source, size = ball(config.hsv, config.vision, fov, clock), config.hsv.target_diameter_m
+        if verified and not config.hsv.simple:
+            source = VerifiedSource(source, shipped())
     elif config.detector == "aruco":
         source, size = ArucoMarkerDetector(config.aruco, config.vision, fov, clock), config.aruco.marker_size_m
     else:

@@ -109,10 +109,13 @@ def test_a_budget_given_no_clock_reads_the_module_clock(monkeypatch: pytest.Monk
 def test_make_detector_passes_its_clock_to_either_detector() -> None:
     from pilot.vision.aruco import ArucoMarkerDetector
     from pilot.vision.detect import make_detector
+    from pilot.vision.verify import VerifiedSource
 
     clock = StepClock(0.0)
-    hsv = make_detector(PilotConfig(), clock=clock).source
+    verified = make_detector(PilotConfig(), clock=clock).source
     aruco = make_detector(PilotConfig(detector="aruco"), clock=clock).source
+    assert isinstance(verified, VerifiedSource)  # the colour-ball detector behind its learned verifier
+    hsv = verified.source
     assert isinstance(hsv, HsvBlobDetector) and hsv.budget.clock is clock
     assert isinstance(aruco, ArucoMarkerDetector) and aruco.budget.clock is clock
 
