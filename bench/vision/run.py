@@ -24,7 +24,7 @@ import vision_eval as ve
 import vision_imagery as vi
 import vision_sequences as vs
 
-from pilot.common.config import ControllerConfig
+from pilot.common.config import ControllerConfig, PilotConfig
 from pilot.vision.aruco import ArucoMarkerDetector
 from pilot.vision.hsv.detector import HsvBlobDetector
 
@@ -192,7 +192,8 @@ def gate_sweep(n: int) -> list[str]:
     cfg = ControllerConfig()
     per, empty, distr = n // 5, n, n // 5
     out = ["", f"## The gate on sequences (HSV, whole pipeline): {per} target sequences per condition "
-           f"({vs.TARGET_FRAMES} frames, ball 32-120 px near the centre), {empty} empty and {distr} per distractor "
+           f"({vs.TARGET_FRAMES} frames, ball {'-'.join(f'{d:.0f}' for d in vs.firing_sizes(PilotConfig()))} px near "
+           f"the centre), {empty} empty and {distr} per distractor "
            f"kind ({vs.NEGATIVE_FRAMES} frames, centring and range lifted)", "",
            "Tuning photos. Confirmed: target sequences confirmed on the ball within K frames (worst condition but "
            "occlusion / occlusion); negatives confirmed at all.", "",

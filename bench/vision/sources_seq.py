@@ -2,10 +2,11 @@
 
 A video run is a fixed 4:3 crop (half to all of the frame's height) of ``FRAMES`` consecutive frames at 320x240:
 the scene's own motion, compression and noise from frame to frame, where vision_sequences.py jitters one still.
-Target runs carry a shaded ball 32-120 px near the centre drifting a pixel or so a frame (a hovering drone's
-view); empty runs carry nothing. ``laser_frames`` replays the gate as the pilot flies it: a frame whose gate is
-confirmed (the laser may be on) while the detection is not on the ball, or on a run with no ball at all, with the
-centring and range conditions lifted for those (as if the drone had turned to face what it saw).
+Target runs carry a shaded ball of a size the pilot fires at (``firing_sizes``) near the centre, drifting a pixel
+or so a frame (a hovering drone's view); empty runs carry nothing. ``laser_frames`` replays the gate as the pilot
+flies it: a frame whose gate is confirmed (the laser may be on) while the detection is not on the ball, or on a run
+with no ball at all, with the centring and range conditions lifted for those (as if the drone had turned to face
+what it saw).
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ def video_runs(video: str, seed: int, targets: int, empty: int, config: PilotCon
             start = int(rng.integers(0, len(frames) - n + 1))
             y, x, ch, cw = _crop(rng, frames[0].shape)
             det = make_detector(cfg)
-            d = float(np.exp(rng.uniform(math.log(32.0), math.log(120.0))))
+            d = float(np.exp(rng.uniform(*np.log(vs.firing_sizes(cfg)))))
             cx, cy = vi.W / 2 + rng.uniform(-0.05, 0.05) * vi.W, vi.H / 2 + rng.uniform(-0.05, 0.05) * vi.H
             dets, truth = [], []
             for k in range(n):

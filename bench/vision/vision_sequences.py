@@ -6,8 +6,8 @@ shake), then the sequence's condition applied afresh (new noise, new blur direct
 Each frame goes through ``make_detector`` (frame checks, detector, tracker), and every Detection is kept,
 so one pass serves every (threshold, N) pair: the gate is replayed on the records.
 
-* target sequences: the ball 32-120 px (nearer than ``controller.fire_range_max_m``, 28 px) near the image
-  centre, where the controller holds it before firing; success = the gate confirms within ``K`` frames
+* target sequences: the ball from its apparent size where the pilot fires (``firing_sizes``) to 120 px near the
+  image centre, where the controller holds it before firing; success = the gate confirms within ``K`` frames
   while the detection lies on the ball.
 * empty and distractor sequences: the gate with the centring and range conditions lifted (as if the
   drone had flown to face whatever it saw); failure = it confirms at all within ``L`` frames.
@@ -24,7 +24,7 @@ import numpy as np
 import numpy.typing as npt
 import vision_imagery as vi
 
-from pilot.common.config import ControllerConfig, PilotConfig
+from pilot.common.config import FIRE_RANGE_SHARE, ControllerConfig, PilotConfig
 from pilot.vision.detect import make_detector
 from pilot.vision.detection import Detection
 from pilot.vision.gating import Gate
@@ -40,6 +40,15 @@ class Sequence:
     detections: tuple[Detection, ...]
     truth: tuple[tuple[float, float], ...]  # ball centre per frame (targets)
     size: float = 0.0
+
+
+def firing_sizes(config: PilotConfig) -> tuple[float, float]:
+    """The ball's apparent diameters (px at the bench's width) over which the pilot fires: from the range it aims
+    within (``FIRE_RANGE_SHARE`` of ``controller.fire_range_max_m``) to 120 px. A fixed floor went stale when the
+    fire range changed (3 -> 2 m): a third of the target runs then lay beyond it and could never confirm."""
+    c = config.controller
+    focal_px = (vi.W / 2.0) / math.tan(math.radians(c.horizontal_fov_deg) / 2.0)
+    return config.hsv.target_diameter_m * focal_px / (FIRE_RANGE_SHARE * c.fire_range_max_m), 120.0
 
 
 SHAKE = (1.5, 1.5, 0.4, 0.006)  # per-frame steps: x, y (px), rotation (deg), scale
@@ -79,7 +88,7 @@ def sequences(split: tuple[str, ...], seed: int, per_condition: int, empty: int,
     for cond in SEQ_CONDITIONS:
         for _ in range(per_condition):
             img = vi.view(rng, split)
-            d = float(np.exp(rng.uniform(math.log(32.0), math.log(120.0))))
+            d = float(np.exp(rng.uniform(*np.log(firing_sizes(cfg)))))
             cx = vi.W / 2 + rng.uniform(-0.05, 0.05) * vi.W
             cy = vi.H / 2 + rng.uniform(-0.05, 0.05) * vi.H
             vi.shaded_ball(img, cx, cy, d, rng)

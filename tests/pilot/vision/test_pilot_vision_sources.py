@@ -3,6 +3,7 @@ loaded as stills, the split kept by source, and the laser-on count replayed thro
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import cv2
@@ -61,3 +62,16 @@ def test_laser_on_frames_count_a_confirmed_gate_off_the_ball_or_without_one() ->
     assert sq.laser_frames(off_ball) == 3
     broken = vs.Sequence("empty", "video", (_seen(True), _seen(True), _seen(False), _seen(True), _seen(True)), ())
     assert sq.laser_frames(broken) == 0
+
+
+def test_target_runs_are_drawn_where_the_pilot_fires() -> None:
+    """The gate confirms a ball only within the fire range: target runs beyond it could never confirm."""
+    from pilot.common.config import PilotConfig
+
+    config = PilotConfig()
+    lo, hi = vs.firing_sizes(config)
+    focal = (vi.W / 2) / np.tan(np.radians(config.controller.horizontal_fov_deg) / 2)
+    at_fire_range = config.hsv.target_diameter_m * focal / config.controller.fire_range_max_m
+    assert at_fire_range < lo < hi == 120.0
+    nearer = dataclasses.replace(config, controller=dataclasses.replace(config.controller, fire_range_max_m=1.0))
+    assert vs.firing_sizes(nearer)[0] == pytest.approx(2 * lo)
