@@ -8,7 +8,7 @@ ArUco clean, motion-blurred and with a corner covered, and the cost per frame ag
 The colour detector's candidates pass the learned verifier (pilot/vision/verify.py) as the pilot runs them; its
 single-view figures are also given for the rules alone, from the same candidates.
 The accuracy runs freeze the budget's clock (the rules judged alone, the same on any machine's load); the cost runs
-keep the default budget (``vision.budget_ms``) on the wall clock, as the pilot flies.
+keep the default budget (``vision.budget_ms``) on the thread's CPU clock, as the pilot flies.
 """
 
 from __future__ import annotations
@@ -232,7 +232,7 @@ def main(argv: list[str] | None = None) -> int:
             "## The gate on target sequences: confirmed on the ball within "
             f"{vs.TARGET_FRAMES} frames", "", *seq_rows(results), "",
             "## ArUco (markers 24-120 px; corner: 12 % of the black square covered)", "", *aruco_rows(results), "",
-            "## Cost per frame (default budget, wall clock; CPU time of the thread beside it)", "", *timing, ""]
+            "## Cost per frame (default budget on the thread's CPU clock; wall time beside it)", "", *timing, ""]
     text = "\n".join(out)
     print(text)
     if not args.no_write:

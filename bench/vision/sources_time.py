@@ -1,7 +1,7 @@
 """Cost per frame of the colour detector on each set of packaged stills (sources_run.py): its default budget
-(``vision.budget_ms``) on the wall clock as the pilot runs it, against the cvtColor+inRange floor measured in turn
-on the same frames, at 320x240 per set and at 640x480 over all sets. Wall time on a shared machine includes other
-processes' turns; the thread's CPU time does not: both are given, the goals read on CPU time.
+(``vision.budget_ms``, on the thread's CPU clock) as the pilot runs it, against the cvtColor+inRange floor measured
+in turn on the same frames, at 320x240 per set and at 640x480 over all sets. Wall time on a shared machine includes
+other processes' turns; the thread's CPU time does not: both are given, the goals read on CPU time.
 """
 
 from __future__ import annotations

@@ -1,9 +1,10 @@
 """A per-frame time budget for the detectors: the frame's first look always runs, each further refinement only
 while time is left, so a frame full of the target's colour costs about the budget and never the tick.
 
-The clock is injected (tests advance it by hand, or freeze ``CLOCK`` to judge a detector's rules alone);
-``exhausted`` tells the caller that the frame's answer is the best candidate found before the time ran out, which
-the pilot's log records.
+The clock is the calling thread's CPU time: a frame is cut short by its own content, never by another process's
+turns on a shared core, so the same frame gets the same answer at any load. It is injected (tests advance it by
+hand, or freeze ``CLOCK`` to judge a detector's rules alone); ``exhausted`` tells the caller that the frame's answer
+is the best candidate found before the time ran out, which the pilot's log records.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-CLOCK: Callable[[], float] = time.perf_counter  # seconds; the clock of a budget given none
+CLOCK: Callable[[], float] = time.thread_time  # seconds of this thread's CPU; the clock of a budget given none
 
 
 class FrameBudget:

@@ -59,6 +59,8 @@ class Grown(list[tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]]):
 
     def mask(self, hsv: MatLike) -> MatLike:
         core = _in_range(hsv, self)
+        if not cv2.countNonZero(core):  # nothing for a dark piece to join (an empty view's usual case)
+            return core
         n, labels = cv2.connectedComponents(_in_range(hsv, darker(self, 0.0)), connectivity=8)
         keep = np.zeros(n, np.uint8)
         keep[labels[np.asarray(core) > 0]] = 255  # the dark pieces holding a pixel of the core

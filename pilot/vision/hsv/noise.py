@@ -21,15 +21,18 @@ NOISY = 4.0  # grey levels, the noise's standard deviation: photographs read 0-2
 SMOOTH_SIGMA = 1.5  # px, the Gaussian's: on the dim room's frames 1.0 left 27 of 71 at 0.6, 1.5 48, 2.0 43
 
 # the difference of two Laplacians: zero on any plane, so only noise (and fine texture) responds; its coefficients'
-# squares sum to 36, so the response's standard deviation is 6 times the noise's
-_MASK = np.array([[1, -2, 1], [-2, 4, -2], [1, -2, 1]], np.float32)
+# squares sum to 36, so the response's standard deviation is 6 times the noise's. The mask, [[1, -2, 1], [-2, 4,
+# -2], [1, -2, 1]], is the outer product of [1, -2, 1] with itself: two passes of that give the same integers in a
+# third of the time (0.035 against 0.09 ms at 320x240)
+_PASS = np.array([1, -2, 1], np.float32)
 _MAD_TO_SIGMA = 1.4826  # a Gaussian's standard deviation over its median absolute deviation
 
 
 def noise_level(image: MatLike) -> float:
-    """The standard deviation of the frame's sensor noise in grey levels (about 0.1 ms at 320x240)."""
+    """The standard deviation of the frame's sensor noise in grey levels (about 0.16 ms at 320x240)."""
     grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
-    response = cv2.convertScaleAbs(cv2.filter2D(grey, cv2.CV_16S, _MASK))  # saturates at 255: beyond any median
+    # saturates at 255: beyond any median
+    response = cv2.convertScaleAbs(cv2.sepFilter2D(grey, cv2.CV_16S, _PASS, _PASS))
     hist = cv2.calcHist([response], [0], None, [256], [0, 256]).ravel()
     median = int(np.searchsorted(np.cumsum(hist), response.size / 2.0))
     return _MAD_TO_SIGMA * median / 6.0

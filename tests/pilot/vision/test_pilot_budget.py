@@ -4,6 +4,7 @@ spent, keeps the best candidate found so far, says so (the Detection and the log
 from __future__ import annotations
 
 import logging
+import time
 
 import cv2
 import numpy as np
@@ -104,6 +105,20 @@ def test_a_budget_given_no_clock_reads_the_module_clock(monkeypatch: pytest.Monk
     det = HsvBlobDetector(vision=VisionConfig(budget_ms=2.0))
     det.candidates(red_heavy())
     assert det.cut_short and clock.reads > 0
+
+
+def test_the_default_clock_counts_the_threads_cpu_not_the_wait(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Another process's turns on a shared core must not cut a frame short: the budget counts this thread's CPU
+    time. A 20 ms sleep (no CPU) leaves a 5 ms budget unspent, where the wall clock would have spent it."""
+    monkeypatch.undo()  # conftest.py froze the module clock: the real default here
+    b = FrameBudget(5.0)
+    b.start()
+    time.sleep(0.02)
+    assert not b.out()
+    t0 = time.thread_time()
+    while time.thread_time() - t0 < 0.006:  # 6 ms of this thread's own work
+        pass
+    assert b.out()
 
 
 def test_make_detector_passes_its_clock_to_either_detector() -> None:

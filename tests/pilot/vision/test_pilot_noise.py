@@ -49,6 +49,19 @@ def test_noise_level_leaves_a_clean_photo_under_the_bar_and_its_noisy_copy_over_
     assert noise_level(photo) < NOISY <= noise_level(noisy)
 
 
+@pytest.mark.parametrize("name", vi.TUNING)
+def test_noise_level_is_immerkaers_estimate_to_the_grey_level(name: str) -> None:
+    """The two passes of [1, -2, 1] (noise.py) give the 3x3 mask's response exactly, at the frame's border too."""
+    mask = np.array([[1, -2, 1], [-2, 4, -2], [1, -2, 1]], np.float32)
+    photo = cv2.resize(vi.photo(name), (321, 239), interpolation=cv2.INTER_AREA)
+    for frame in (photo, np.clip(photo + np.random.default_rng(3).normal(0.0, 9.0, photo.shape), 0, 255)
+                  .astype(np.uint8)):
+        grey = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
+        response = cv2.convertScaleAbs(cv2.filter2D(grey, cv2.CV_16S, mask))
+        median = int(np.searchsorted(np.cumsum(np.bincount(response.ravel(), minlength=256)), response.size / 2.0))
+        assert noise_level(frame) == 1.4826 * median / 6.0
+
+
 def found_at(det: HsvBlobDetector, frame: np.ndarray, cx: float, cy: float) -> bool:
     cands = det.candidates(frame)
     return bool(cands) and cands[0].score >= 0.6 and math.hypot(cands[0].cx - cx, cands[0].cy - cy) <= 3.0
