@@ -81,7 +81,7 @@ class TrackedDetector:
 
 def make_detector(config: PilotConfig, clock: Callable[[], float] | None = None, verified: bool = True
                   ) -> TrackedDetector:
-    """``clock``: seconds, for the frame's budget (default ``pilot.vision.budget.CLOCK``, the wall clock);
+    """``clock``: seconds, for the frame's budget (default ``pilot.vision.budget.CLOCK``, the thread's CPU time);
     ``verified``: the colour-ball detector's candidates pass the learned verifier (``pilot.vision.verify``; False:
     the rules alone, as the bench compares)."""
     fov = config.controller.horizontal_fov_deg
