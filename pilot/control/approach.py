@@ -4,7 +4,7 @@ The flight controller holds altitude but not position: a drone that stops comman
 pilot has no other velocity sensor, so it fits a line to the last ``window_s`` of range estimates: 0.4 s, a compromise
 between the slope's noise (about 0.35 m/s for a 25 px target at 3 m at 20 Hz, a quarter of it at 1.5 m) and
 its lag (0.2 s, which makes a brake overshoot). A brake counts only the speed the ranges show for certain: the fit
-less its standard error (``ClosingSpeed.sure``), from the ranges' scatter or the ball's size (``SIZE_JITTER_PX``).
+less its standard error (``ClosingSpeed.sure``), from the ball's size (``SIZE_JITTER_PX``).
 """
 
 from __future__ import annotations
@@ -55,15 +55,16 @@ class ClosingSpeed:
 
     @property
     def error(self) -> float | None:
-        """The closing speed's standard error (m/s), None with ``closing``: from the ranges' scatter about the
-        fitted line, or from their expected errors if more (a few samples can fall on a line by chance)."""
+        """The closing speed's standard error (m/s) from the ranges' expected errors, None with ``closing``. Not
+        their scatter: a few ranges fall on a line by chance (``distractor`` 3012: four of a 16 px ball, 0.27 m/s
+        for 1.1), and a near ball clipped by the frame's edges scatters for a reason (``low`` 3009: 0.47 m/s at
+        150 px, which then braked too little at a loss, into the ball)."""
         n = len(self._samples)
-        if n < max(3, self.min_samples):
+        if n < self.min_samples:
             return None
         mt = sum(t for t, _ in self._samples) / n
         spread = sum((t - mt) ** 2 for t, _ in self._samples)
-        expected = math.sqrt(sum(e * e for e in self._noise) / n / spread) if spread > 0.0 else 0.0
-        return max(slope_error(self._samples) or 0.0, expected)
+        return math.sqrt(sum(e * e for e in self._noise) / n / spread) if spread > 0.0 else 0.0
 
     @property
     def sure(self) -> float | None:
@@ -83,19 +84,6 @@ def slope(samples: Sequence[tuple[float, float]]) -> float | None:
     if var <= 0.0:
         return None
     return sum((t - mt) * (v - mv) for t, v in samples) / var
-
-
-def slope_error(samples: Sequence[tuple[float, float]]) -> float | None:
-    """The standard error of ``slope``'s estimate (None: fewer than three samples or no spread in time)."""
-    n = len(samples)
-    rate = slope(samples)
-    if n < 3 or rate is None:
-        return None
-    mt = sum(t for t, _ in samples) / n
-    mv = sum(v for _, v in samples) / n
-    var = sum((t - mt) ** 2 for t, _ in samples)
-    residual = sum((v - mv - rate * (t - mt)) ** 2 for t, v in samples)
-    return math.sqrt(residual / (n - 2) / var)
 
 
 def allowed_speed(remaining_m: float, brake_mps2: float, top_mps: float) -> float:
