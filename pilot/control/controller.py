@@ -296,8 +296,7 @@ class Controller(ControllerCore):
             # the range still to go before the aim range (range scales as 1/size), and the speed allowed there
             allowed = allowed_speed(det.range_m * (1.0 - size / cfg.approach_size), cfg.brake_mps2,
                                     cfg.approach_speed_mps)
-            # braking before any other correction, for the speed the ranges show for certain (``approach.py``)
-            if closing - error > allowed + 0.15:
+            if closing - error > allowed + 0.15:  # braking first, for the speed shown for certain (approach.py)
                 return self._brake(closing - error - allowed, det)
         if abs(ex) > cfg.dead_band_x:
             return self._emit(turn_towards(ex, self.pulses))
