@@ -3,7 +3,8 @@
 The flight controller holds altitude but not position: a drone that stops commanding forward coasts on. The
 pilot has no other velocity sensor, so it fits a line to the last ``window_s`` of range estimates: 0.4 s, a compromise
 between the slope's noise (about 0.35 m/s for a 25 px target at 3 m at 20 Hz, a quarter of it at 1.5 m) and
-its lag (0.2 s, which makes a brake overshoot).
+its lag (0.2 s, which makes a brake overshoot). A brake counts only the speed the ranges show for certain: the fit
+less its standard error (``ClosingSpeed.sure``), from the ball's size (``SIZE_JITTER_PX``).
 """
 
 from __future__ import annotations
@@ -12,6 +13,11 @@ import math
 from collections import deque
 from collections.abc import Sequence
 
+# the detector's diameter of a ball jitters by about half a pixel from frame to frame (13-17 px balls at 4-6 m in
+# ``occluded`` 3010 and ``distractor`` 3012): a range from it errs by range * 0.5 / size, 0.15 m at 5 m, and a fit
+# of four such ranges over 0.15 s then reads 1.1 m/s on a drone closing at 0.16 (``distractor`` 3012 braked on it)
+SIZE_JITTER_PX = 0.5
+
 
 class ClosingSpeed:
     def __init__(self, window_s: float = 0.4, min_samples: int = 4, max_rate: float = 2.5) -> None:
@@ -19,20 +25,25 @@ class ClosingSpeed:
         self.min_samples = min_samples
         self.max_rate = max_rate  # m/s between two samples that no flight reaches: a new target, start again
         self._samples: deque[tuple[float, float]] = deque()
+        self._noise: deque[float] = deque()  # each range's expected error (m), beside its sample
 
     def reset(self) -> None:
         self._samples.clear()
+        self._noise.clear()
 
-    def update(self, t: float, range_m: float) -> None:
+    def update(self, t: float, range_m: float, size_px: float = 0.0) -> None:
+        """A range estimate at ``t`` (s); ``size_px``: the apparent diameter it rests on (0: no expected error)."""
         if range_m <= 0.0 or not math.isfinite(range_m):
             return
         if self._samples:
             t0, r0 = self._samples[-1]
             if t <= t0 or abs(range_m - r0) > self.max_rate * (t - t0):
-                self._samples.clear()
+                self.reset()
         self._samples.append((t, range_m))
+        self._noise.append(range_m * SIZE_JITTER_PX / size_px if size_px > 0.0 else 0.0)
         while self._samples and t - self._samples[0][0] > self.window_s:
             self._samples.popleft()
+            self._noise.popleft()
 
     @property
     def closing(self) -> float | None:
@@ -41,6 +52,25 @@ class ClosingSpeed:
             return None
         rate = slope(self._samples)
         return None if rate is None else -rate
+
+    @property
+    def error(self) -> float | None:
+        """The closing speed's standard error (m/s) from the ranges' expected errors, None with ``closing``. Not
+        their scatter: a few ranges fall on a line by chance (``distractor`` 3012: four of a 16 px ball, 0.27 m/s
+        for 1.1), and a near ball clipped by the frame's edges scatters for a reason (``low`` 3009: 0.47 m/s at
+        150 px, which then braked too little at a loss, into the ball)."""
+        n = len(self._samples)
+        if n < self.min_samples:
+            return None
+        mt = sum(t for t, _ in self._samples) / n
+        spread = sum((t - mt) ** 2 for t, _ in self._samples)
+        return math.sqrt(sum(e * e for e in self._noise) / n / spread) if spread > 0.0 else 0.0
+
+    @property
+    def sure(self) -> float | None:
+        """The closing speed less its standard error: as fast as the ranges show for certain."""
+        closing, error = self.closing, self.error
+        return None if closing is None else closing - (error or 0.0)
 
 
 def slope(samples: Sequence[tuple[float, float]]) -> float | None:
@@ -70,13 +100,19 @@ class Momentum:
         self.accel_per_step = accel_per_step
         self.decay_s = decay_s
         self.speed = 0.0  # m/s forward
+        self.error = 0.0  # the standard error of the vision estimate it last took (``ClosingSpeed.error``)
 
     def reset(self) -> None:
-        self.speed = 0.0
+        self.speed = self.error = 0.0
 
-    def observe(self, closing: float | None) -> None:
+    def observe(self, closing: float | None, error: float | None = None) -> None:
         if closing is not None:
-            self.speed = closing
+            self.speed, self.error = closing, error or 0.0
+
+    @property
+    def sure(self) -> float:
+        """The speed less the standard error of the vision estimate it was last given."""
+        return self.speed - self.error
 
     def advance(self, pitch_steps: float, dt: float) -> None:
         """``pitch_steps``: the pitch stick held during ``dt``, in control steps (forward positive)."""

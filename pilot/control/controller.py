@@ -112,9 +112,9 @@ class Controller(ControllerCore):
         self.height.advance(self.sticks.throttle(now), dt)
         self._last_ms = now
         if det is not None and det.found and self.state in LOCKED:
-            self.closing.update(now / 1000.0, det.range_m)
-            self.closing_trend.update(now / 1000.0, det.range_m)
-            self.momentum.observe(self.closing.closing)
+            self.closing.update(now / 1000.0, det.range_m, det.size)
+            self.closing_trend.update(now / 1000.0, det.range_m, det.size)
+            self.momentum.observe(self.closing.closing, self.closing.error)
         elif self.state not in LOCKED and self.state is not State.SEARCH:
             self.closing.reset()
             self.closing_trend.reset()
@@ -235,8 +235,8 @@ class Controller(ControllerCore):
         closing in, the search starts by braking for as long as the last closing speed needs."""
         off = self._laser(False)
         # vision's last estimate carried on by dead reckoning, the commands' own reckoning, or the longer trend:
-        # whichever is fastest
-        closing = max(self.momentum.speed, self.reckoned.speed, self.closing_trend.closing or 0.0)
+        # whichever is fastest, vision's less their standard errors (``approach.py``: far, a fit swings by 1 m/s)
+        closing = max(self.momentum.sure, self.reckoned.speed, self.closing_trend.sure or 0.0)
         if closing > 0.15:
             # as long as that brake takes to stop it (plus the lean's lag), not longer: a brake held on flies the
             # drone backwards into whatever is behind it, where the camera does not look
@@ -289,15 +289,15 @@ class Controller(ControllerCore):
         if size >= cfg.approach_size:  # close enough whatever else is off: AIM centres it with the servos
             self._go(State.AIM, f"close enough (size {size:.3f})")
             return self._on_aim(det)
-        closing, allowed = self._closing_now(), cfg.approach_speed_mps
-        if closing is None:  # too few consistent ranges yet: the speed its own pitch commands gave it
-            closing = self.momentum.speed
+        closing, allowed, error = self._closing_now(), cfg.approach_speed_mps, self.closing.error
+        if closing is None or error is None:  # too few consistent ranges yet: the speed its own pitch commands gave it
+            closing, error = self.momentum.speed, self.momentum.error
         if det.range_m > 0.0:
             # the range still to go before the aim range (range scales as 1/size), and the speed allowed there
             allowed = allowed_speed(det.range_m * (1.0 - size / cfg.approach_size), cfg.brake_mps2,
                                     cfg.approach_speed_mps)
-            if closing > allowed + 0.15:  # braking comes before any other correction
-                return self._brake(closing - allowed, det)
+            if closing - error > allowed + 0.15:  # braking first, for the speed shown for certain (approach.py)
+                return self._brake(closing - error - allowed, det)
         if abs(ex) > cfg.dead_band_x:
             return self._emit(turn_towards(ex, self.pulses))
         if abs(ey) > cfg.dead_band_y and not self.seen_from.barred(ey < 0, self.height.settles_m, ey):
