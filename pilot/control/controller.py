@@ -143,9 +143,9 @@ class Controller(ControllerCore):
             self._pitch_calm_ms = self._now()
         calm = self._now() - self._pitch_calm_ms >= PITCH_CALM_MS
         closing = self.closing.closing if calm else None
-        scene = None if det is None else det.scene
-        shaped = self.drift.step(frame, self._now(), sighting, closing, self.state in TRIMMED, scene)
-        self.last_command = shaped if shaped is not frame and shaped is not None else self.last_command
+        shaped = self.drift.step(frame, self._now(), sighting, closing, self.state in TRIMMED)
+        if shaped is not frame and shaped is not None:
+            self.last_command = shaped
         return shaped
 
     def _decide_frame(self, det: Detection | None) -> bytes | None:

@@ -20,10 +20,8 @@ from dataclasses import dataclass
 
 import drone_protocol as dp
 
-from ..vision.detection import SceneShift
 from .approach import slope
 from .pulses import StickModel
-from .scene_drift import scene_speeds
 
 LATERAL_WINDOW_S = 1.0  # the sideways speed is the slope of this much of the lateral offset
 LATERAL_MIN_SAMPLES = 6
@@ -41,8 +39,6 @@ FRAME_AGE_S = 0.075
 # ArduCopter's default ATC_ACCEL_Y_MAX, 270°/s^2), 2.2° at a full step; harder turns than half a step restart the
 # window and settle as before
 GENTLE_TURN_STEPS = 0.5
-# the scene's growth is the drift's forward speed once the pilot's own pitch (and the speed it gave) is this old
-SCENE_CALM_MS = 1500
 REANCHOR_DEG = 10.0  # the window restarts past this change of heading (about 1° of lag each turn adds)
 _AXES = (dp.ChannelName.ROLL, dp.ChannelName.PITCH)
 _SENSE = {dp.CommandName.MOVE_RIGHT: (dp.ChannelName.ROLL, 1.0), dp.CommandName.MOVE_LEFT: (dp.ChannelName.ROLL, -1.0),
@@ -207,8 +203,6 @@ class DriftHold:
         self._yaw_dps = 0.0  # the yaw rate the firmware's stick holds ...
         self._yaw_until_ms = 0  # ... until its command timeout
         self._headings: deque[tuple[int, float]] = deque()  # (ms, heading) over the last FRAME_AGE_S
-        self._shown_deg = 0.0  # the heading the last frame showed
-        self._pitch_ms = -SCENE_CALM_MS  # when the controller's own pitch last moved the drone
 
     def _reckon(self, now_ms: int, dt: float) -> float:
         """Advance the reckoned heading; the heading the present frame shows (``FRAME_AGE_S`` ago)."""
@@ -222,30 +216,19 @@ class DriftHold:
         return self._headings[0][1]
 
     def step(self, frame: bytes | None, now_ms: int, sighting: tuple[float, float] | None,
-             closing: float | None, apply: bool, scene: SceneShift | None = None) -> bytes | None:
+             closing: float | None, apply: bool) -> bytes | None:
         """``sighting``: the target's range (m) and bearing from the body (degrees right) in this frame, if
         measured; ``closing``: its closing speed (m/s) where the pilot commands no approach; ``apply``: lean
-        against the drift in this state (else the frame goes as it is); ``scene``: the whole scene's motion since
-        the last frame, learnt from where the target gives no speed (``scene_drift``), in the states that lean."""
+        against the drift in this state (else the frame goes as it is)."""
         dt = 0.0 if self._last_ms is None else max(0.0, (now_ms - self._last_ms) / 1000.0)
         shown_deg = self._reckon(now_ms, dt)
-        turned_deg, self._shown_deg = shown_deg - self._shown_deg, shown_deg
         self._last_ms = now_ms
         sideways = None
-        settled = now_ms - self._moved_ms >= SETTLE_MS
         if sighting is None:
             self.drift.heading_moved()  # not seen: a loss, a cover, a frame the target was not confirmed in
-        elif settled:
+        elif now_ms - self._moved_ms >= SETTLE_MS:
             self.drift.see(now_ms / 1000.0, sighting[0], sighting[1], shown_deg)
             sideways = self.drift.sideways
-        if _pitches(frame):
-            self._pitch_ms = now_ms
-        flow = scene_speeds(scene, turned_deg, dt) if apply else None
-        if flow is not None:
-            if sideways is None and settled:
-                self.drift.learn(flow[0], None, dt)
-            if closing is None and now_ms - self._pitch_ms >= SCENE_CALM_MS:
-                self.drift.learn(None, flow[1], dt)
         self.drift.learn(sideways, closing, dt)
         if apply:
             right = self.drift.right - DAMP_DEG_PER_MPS * (sideways or 0.0)
@@ -273,12 +256,6 @@ class DriftHold:
             self._yaw_until_ms = now_ms + dp.COMMAND_TIMEOUT_MS
         elif dp.COMMANDS[command.name].target in _STICK_TARGETS or command.name is dp.CommandName.HOLD_ALTITUDE:
             self._yaw_dps = 0.0
-
-
-def _pitches(frame: bytes | None) -> bool:
-    """Whether ``frame`` is a pitch command of the controller's own."""
-    command = _decode_any(frame)
-    return command is not None and command.name in (dp.CommandName.MOVE_FORWARD, dp.CommandName.MOVE_BACKWARD)
 
 
 def _decode_any(frame: bytes | None) -> dp.Command | None:

@@ -9,7 +9,6 @@ The pipeline (each part in its own module):
 3. ``pilot.vision.tracking``: one track picks the candidate consistent with the last frames, rejects jumps and
    bridges a few missed frames. A target the pilot acts on that the frame's look misses first gets a closer
    look where the track expects it (``candidates_near``).
-   Beside it, ``pilot.vision.motion`` measures the whole scene's motion since the last frame (the drift's witness).
 4. The controller's ``pilot.vision.gating.Gate`` turns confidences into "act on it" and "the laser may fire".
 """
 
@@ -26,7 +25,6 @@ from .ball import SimpleBallDetector
 from .detection import CandidateSource, Detection, Detector, FrameStatus, range_of, reported_size
 from .frames import FrameCheck
 from .hsv.detector import HsvBlobDetector
-from .motion import SceneMotion
 from .tracking import Tracker
 from .verify import VerifiedSource, shipped
 
@@ -53,16 +51,13 @@ class TrackedDetector:
         self.frames = FrameCheck(cfg.frozen_frames)
         self.tracker = Tracker(cfg)
         self.look_again_from = look_again_from
-        self.motion = SceneMotion(fov_deg)
 
     def detect(self, image: MatLike) -> Detection:
         status = self.frames.check(image)
         w, h = reported_size(image)
         if status is not FrameStatus.OK:
             self.tracker.reset()  # nothing seen through a bad frame carries over
-            self.motion.reset()
             return Detection(False, width=w, height=h, status=status)
-        scene = self.motion.update(image)
         candidates = self.source.candidates(image)
         # a target the pilot acts on, not in this frame's look: a closer look where it should be (a ball darkening
         # as a bright window fills more of the frame drops under the frame's V bound); ``takes`` is False without
@@ -73,15 +68,15 @@ class TrackedDetector:
         out = self.tracker.update(candidates, w)
         cut = self.source.cut_short
         if out is None:
-            return Detection(False, width=w, height=h, cut_short=cut, scene=scene)
+            return Detection(False, width=w, height=h, cut_short=cut)
         c = out.candidate
         if not (0.0 <= c.cx < w and 0.0 <= c.cy < h):  # a bridged target gone past the frame's edge: lost, not
             self.tracker.reset()  # reported where no pixel shows it (a marker was logged at cx -61)
-            return Detection(False, width=w, height=h, cut_short=cut, scene=scene)
+            return Detection(False, width=w, height=h, cut_short=cut)
         distance = range_of(c.size, self.object_m, w, self.fov_deg)
         aim = None if out.predicted else self.source.aim_on_target(image, c.size)
         return Detection(True, c.cx, c.cy, c.size, c.score, w, h, range_m=distance, predicted=out.predicted,
-                         aim_on_target=aim, cut_short=cut, scene=scene)
+                         aim_on_target=aim, cut_short=cut)
 
 
 def make_detector(config: PilotConfig, clock: Callable[[], float] | None = None, verified: bool = True

@@ -51,15 +51,6 @@ class Candidate:
 
 
 @dataclass(frozen=True)
-class SceneShift:
-    """The whole scene's apparent motion since the previous frame (``pilot.vision.motion``)."""
-
-    turn_deg: float  # the camera seems to have turned this far to the right (the scene slid left)
-    scale: float  # the scene grew by this factor (above 1: the camera came nearer)
-    points: int  # the corners the fit rests on
-
-
-@dataclass(frozen=True)
 class Detection:
     found: bool
     cx: float = 0.0  # centre, pixels
@@ -73,7 +64,6 @@ class Detection:
     predicted: bool = False  # bridged by the tracker through a missed frame, not measured in this one
     aim_on_target: bool | None = None  # the laser's aim point shows the target itself (None: not measured)
     cut_short: bool = False  # the frame's time budget ran out: the best candidate found before it
-    scene: SceneShift | None = None  # the scene's motion since the last frame (None: not measured)
 
     @property
     def error_x(self) -> float:
