@@ -113,11 +113,13 @@ def test_missing_virtual_drone_is_explained(tmp_path: Path) -> None:
     assert code == 2 and "make firmware-host" in err
 
 
-def test_python_dash_m_pilot(virtual_drone: Path) -> None:
+def test_python_dash_m_pilot_flies_the_demos_flight(virtual_drone: Path) -> None:
+    """The flight `make demo` promises a newcomer (pilot/pilot.mk's DEMO_FLIGHT_ARGS), through `python -m pilot`."""
+    line = next(x for x in (REPO / "pilot" / "pilot.mk").read_text().splitlines() if x.startswith("DEMO_FLIGHT_ARGS"))
+    demo = line.split("?=", 1)[1].split()
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(REPO), str(REPO / "generated" / "python")]))
     proc = subprocess.run(
-        [sys.executable, "-m", "pilot", "--virtual-drone", str(virtual_drone), "--scenario", "low", "--seed", "1",
-         "--ideal"],
+        [sys.executable, "-m", "pilot", "--virtual-drone", str(virtual_drone), *demo],
         cwd=REPO,
         env=env,
         capture_output=True,
