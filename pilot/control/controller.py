@@ -22,7 +22,7 @@ from ..common.config import FIRE_RANGE_SHARE, ControllerConfig
 from ..vision.detection import Detection
 from ..vision.gating import Gate, centred
 from .approach import ClosingSpeed, Lead, Lean, Momentum, allowed_speed, brake_steps
-from .controller_core import FLYING, KEPT, LOCKED, ControllerCore, State, Transition, turn_towards
+from .controller_core import FLYING, LOCKED, ControllerCore, State, Transition, turn_towards
 from .descent import DESCENT_STEPS, Descent
 from .lock import Lock
 from .response import TurnResponse, turn_sense
@@ -151,7 +151,7 @@ class Controller(ControllerCore):
     def _decide_frame(self, det: Detection | None) -> bytes | None:
         # -- vision gate (issue 12): a bad frame holds (laser off), too many in a row land ------------
         self.gate.observe(det)
-        self._sighted = self.lock.sighted(det, self.gate.acquired(), self.state in KEPT, self.cfg.acquire_confidence)
+        self._sighted = self.lock.sighted(det, self.gate.acquired(), self.state in LOCKED, self.cfg.acquire_confidence)
         if self.gate.fault is not None and self.state in FLYING - {State.TAKEOFF, State.HOLD}:
             if self.gate.fault_frames >= self.cfg.blind_frames:
                 off = self._laser(False)

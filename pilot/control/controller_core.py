@@ -36,7 +36,6 @@ class State(enum.Enum):
 
 FLYING = frozenset({State.TAKEOFF, State.HOLD, State.SEARCH, State.ACQUIRE, State.TRACK, State.AIM, State.FIRE})
 LOCKED = frozenset({State.ACQUIRE, State.TRACK, State.AIM, State.FIRE})
-KEPT = LOCKED  # once a frame is acquired, a lock is kept at a lower confidence (``lock.py``)
 RESET_ERROR = 0.4  # a servo reset in TRACK may leave the target this far off the middle (of the half-width)
 # a servo step shows in the frames only this long after it is sent: a frame is 30-120 ms old when the pilot reads it
 # (one camera period more after a dropped frame), the servo slews 0.1-0.2 s per 60°, and the step goes out at a tick
